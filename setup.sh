@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# mcrecon setup: install Debian 12 packages, configure and build.
+#   bash setup.sh          install + build
+#   bash setup.sh demo     install + build + run the demo on the embedded sample scenes
+#   bash setup.sh test     install + build + run every test (ctest)
+set -euo pipefail
+cd "$(dirname "$0")"
+BUILD_DIR=${BUILD_DIR:-build}
+JOBS=${JOBS:-$(nproc)}
+
+PACKAGES=(
+  cmake g++ ninja-build pkg-config
+  libopenimageio-dev openimageio-tools python3-openimageio
+  libopenexr-dev libopencolorio-dev
+  libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
+  libgtest-dev libbenchmark-dev
+  pybind11-dev python3-pybind11 python3-numpy
+  blender
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${missing[*]}"
+  SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"
+fi
+
+cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3
+cmake --build "$BUILD_DIR" -j "$JOBS"
+
+case "${1:-build}" in
+  build) ;;
+  demo) shift; "$BUILD_DIR/bin/mcrecon" demo --out "${DEMO_OUT:-demo_out}" "$@" ;;
+  test) ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" ;;
+  *) echo "setup: unknown action '$1' (use build, demo or test)" >&2; exit 2 ;;
+esac
