@@ -59,6 +59,7 @@ class Frame {
   int width = 0, height = 0;
   std::string path;   // input file, for messages
   std::string layer;  // chosen view layer ("" for plain files)
+  std::vector<std::string> layers;  // every layer in the file
   int frame_number = 0;
   std::vector<Pass> passes;
   std::vector<Pass> extra;  // channels with no role, carried by --keep-passes

@@ -1,0 +1,132 @@
+#include <cstdio>
+#include <filesystem>
+#include <iostream>
+#include <regex>
+
+#include "commands.h"
+#include "io/atomic_write.h"
+#include "io/sequence.h"
+#include "pipeline/denoise_file.h"
+#include "progress.h"
+#include "util/error.h"
+
+namespace mcr::cli {
+
+namespace {
+
+struct DenoiseArgs {
+  std::string input, output, filter, layer, frames, region, compression = "zip";
+  std::vector<std::string> sets, passes;
+  bool keep_passes = false, timings = false, verbose = false, resume = false;
+  int threads = 0;
+};
+
+Roi parse_region(const std::string& text) {
+  static const std::regex re(R"(^\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)\s*,\s*(\d+)\s*$)");
+  std::smatch m;
+  if (!std::regex_match(text, m, re))
+    throw Error(Errc::InvalidArgument, "--region expects X0,Y0,X1,Y1 (pixels, end exclusive), got '" + text + "'");
+  Roi r{std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3]), std::stoi(m[4])};
+  if (r.empty()) throw Error(Errc::InvalidArgument, "--region '" + text + "' is empty");
+  return r;
+}
+
+std::string times_text(const StageTimes& t) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "read %.1f ms, filter %.1f ms, write %.1f ms, total %.1f ms", t.read_ms,
+                t.filter_ms, t.write_ms, t.total_ms());
+  return buf;
+}
+
+int run_denoise(const DenoiseArgs& a) {
+  std::vector<std::pair<std::string, std::string>> params;
+  for (const auto& s : a.sets) params.push_back(parse_key_value(s, "--set"));
+  DenoiseSession session(a.filter, params);  // unknown filter / parameter errors first
+
+  ReadOptions ro;
+  ro.layer = a.layer;
+  ro.keep_extra = a.keep_passes;
+  for (const auto& p : a.passes) ro.overrides.push_back(parse_pass_override(p));
+  WriteOptions wo;
+  wo.keep_passes = a.keep_passes;
+  wo.compression = a.compression;
+  ExecOptions eo;
+  eo.nthreads = a.threads;
+  if (!a.region.empty()) eo.roi = parse_region(a.region);
+
+  // Frame list: a single file, or a pattern with --frames.
+  std::vector<std::pair<std::string, std::string>> jobs;
+  const bool seq = is_sequence_pattern(a.input);
+  if (seq) {
+    if (a.frames.empty()) throw Error(Errc::InvalidArgument, "input '" + a.input + "' is a sequence pattern: give --frames A-B");
+    if (!is_sequence_pattern(a.output))
+      throw Error(Errc::InvalidArgument, "output '" + a.output + "' must be a pattern (#### or %04d) for a sequence input");
+    const FrameRange r = parse_frame_range(a.frames);
+    for (int f = r.first; f <= r.last; ++f) jobs.emplace_back(sequence_path(a.input, f), sequence_path(a.output, f));
+  } else {
+    if (!a.frames.empty()) throw Error(Errc::InvalidArgument, "--frames needs a sequence pattern (#### or %04d) as input");
+    jobs.emplace_back(a.input, a.output);
+  }
+  // Check every frame before the first is filtered: a missing frame 90 of 100
+  // or an output over an input should not cost a whole run.
+  std::vector<std::string> inputs;
+  for (const auto& j : jobs) {
+    std::error_code ec;
+    if (!std::filesystem::exists(j.first, ec)) throw Error(Errc::FileNotFound, "cannot read '" + j.first + "': no such file");
+    inputs.push_back(j.first);
+  }
+  for (const auto& j : jobs) check_output_path(j.second, inputs);
+
+  const bool temporal = session.filter().info().temporal;
+  Progress progress("denoise " + a.filter, int(jobs.size()));
+  StageTimes sum;
+  int written = 0, skipped = 0;
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const auto& [in, out] = jobs[i];
+    std::error_code ec;
+    const bool done = a.resume && std::filesystem::exists(out, ec);
+    if (done && !temporal) {
+      ++skipped;
+      if (seq) progress.step(int(i + 1), "skip " + out + " (exists)");
+      continue;
+    }
+    // Temporal filters replay finished frames without writing, to warm up history.
+    const StageTimes t = session.run(in, done ? std::string() : out, ro, wo, eo);
+    sum.read_ms += t.read_ms;
+    sum.filter_ms += t.filter_ms;
+    sum.write_ms += t.write_ms;
+    done ? ++skipped : ++written;
+    if (a.verbose)
+      for (const auto& n : session.filter().notes()) std::cerr << "mcrecon: " << in << ": " << n << "\n";
+    if (seq) progress.step(int(i + 1), (done ? "warm-up " + in : out) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
+    else if (a.timings || a.verbose) std::cerr << "mcrecon: " << out << ": " << times_text(t) << "\n";
+  }
+  if (seq) {
+    progress.finish(std::to_string(written) + " written, " + std::to_string(skipped) + " already done");
+    if (a.timings || a.verbose) std::cerr << "mcrecon: all frames: " << times_text(sum) << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Run add_denoise(CLI::App& app) {
+  auto a = std::make_shared<DenoiseArgs>();
+  app.add_option("input", a->input, "render or sequence pattern (shot_####.exr, shot_%04d.exr)")->required();
+  app.add_option("-o,--output", a->output, "output EXR (a pattern for sequences)")->required();
+  app.add_option("-f,--filter", a->filter, "filter name (see `mcrecon filters`)")->required();
+  app.add_option("-s,--set", a->sets, "filter parameter KEY=VALUE (repeatable)");
+  app.add_option("--layer", a->layer, "view layer (default: the first with a colour pass)");
+  app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)");
+  app.add_option("--frames", a->frames, "frame range A-B for a sequence pattern");
+  app.add_option("--region", a->region, "only filter X0,Y0,X1,Y1 (end exclusive); the rest keeps the input");
+  app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("--compression", a->compression, "EXR compression of the output (zip, piz, none, ...)");
+  app.add_flag("--keep-passes", a->keep_passes, "carry the input's other channels into the output");
+  app.add_flag("--resume", a->resume, "skip frames whose output exists (temporal filters replay them without writing)");
+  app.add_flag("--timings", a->timings, "print read / filter / write times per frame");
+  app.add_flag("-v,--verbose", a->verbose, "timings plus the filter's notes");
+  return [a] { return run_denoise(*a); };
+}
+
+}  // namespace mcr::cli

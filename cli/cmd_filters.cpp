@@ -1,0 +1,41 @@
+#include <iomanip>
+#include <iostream>
+
+#include "commands.h"
+#include "filters/registry.h"
+#include "json_views.h"
+
+namespace mcr::cli {
+
+Run add_filters(CLI::App& app) {
+  auto json_out = std::make_shared<bool>(false);
+  app.add_flag("--json", *json_out, "machine-readable output");
+  return [json_out] {
+    if (*json_out) {
+      nlohmann::json list = nlohmann::json::array();
+      for (const auto& name : filter_names()) list.push_back(to_json(filter_info(name)));
+      std::cout << nlohmann::json{{"filters", list}}.dump(2) << "\n";
+      return 0;
+    }
+    for (const auto& name : filter_names()) {
+      const FilterInfo& f = filter_info(name);
+      std::cout << f.name << ": " << f.summary << (f.temporal ? " [temporal]" : "") << "\n";
+      std::cout << "  needs:";
+      for (Role r : f.required) std::cout << " " << role_name(r);
+      if (!f.optional.empty()) {
+        std::cout << "; uses when present:";
+        for (Role r : f.optional) std::cout << " " << role_name(r);
+      }
+      std::cout << "\n  non-finite input: " << f.nonfinite_policy << "\n";
+      for (const ParamSpec& s : f.params) {
+        std::cout << "  --set " << std::left << std::setw(16) << s.name << " " << param_type_name(s.type)
+                  << ", default " << param_value_text(s.default_value);
+        if (s.type != ParamType::Bool) std::cout << ", " << param_range_text(s);
+        std::cout << ": " << s.help << "\n";
+      }
+    }
+    return 0;
+  };
+}
+
+}  // namespace mcr::cli

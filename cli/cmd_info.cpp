@@ -1,0 +1,91 @@
+#include <iostream>
+
+#include "commands.h"
+#include "filters/registry.h"
+#include "io/frame_reader.h"
+#include "json_views.h"
+
+namespace mcr::cli {
+
+namespace {
+
+struct InfoArgs {
+  std::string input, layer;
+  std::vector<std::string> passes;
+  bool json = false;
+};
+
+int run_info(const InfoArgs& a) {
+  ReadOptions ro;
+  ro.layer = a.layer;
+  ro.require_colour = false;
+  ro.keep_extra = true;
+  for (const auto& p : a.passes) ro.overrides.push_back(parse_pass_override(p));
+  const Frame frame = read_frame(a.input, ro);
+
+  nlohmann::json roles = nlohmann::json::object(), passes = nlohmann::json::array(), other = nlohmann::json::array();
+  for (Role r : kAllRoles) {
+    const Pass* feature = frame.find(r, Prefer::Feature);
+    if (!feature) continue;
+    nlohmann::json j = to_json(*feature);
+    const Pass* geometry = frame.find(r, Prefer::Geometry);
+    if (geometry != feature) j["geometry"] = to_json(*geometry);  // e.g. world Normal beside Denoising Normal
+    roles[role_name(r)] = j;
+  }
+  for (const Pass& p : frame.passes) passes.push_back(to_json(p));
+  for (const Pass& p : frame.extra) other.push_back({{"name", p.name}, {"channels", p.channels}});
+  nlohmann::json filters = nlohmann::json::array();
+  for (const auto& name : filter_names()) {
+    auto f = make_filter(name);
+    nlohmann::json missing = nlohmann::json::array();
+    for (Role r : f->missing_passes(frame)) missing.push_back(role_name(r));
+    filters.push_back({{"name", name}, {"can_run", missing.empty()}, {"missing", missing}});
+  }
+  nlohmann::json j = {{"file", frame.path},   {"width", frame.width},     {"height", frame.height},
+                      {"deep", bool(frame.deep)}, {"layers", frame.layers}, {"layer", frame.layer},
+                      {"roles", roles},       {"passes", passes},         {"other_channels", other},
+                      {"filters", filters}};
+  if (frame.deep) j["deep_samples"] = frame.deep->total_samples();
+  if (a.json) {
+    std::cout << j.dump(2) << "\n";
+    return 0;
+  }
+  std::cout << frame.path << ": " << frame.width << "x" << frame.height << (frame.deep ? " deep" : "") << "\n";
+  std::cout << "layers:";
+  for (const auto& l : frame.layers) std::cout << " " << (l.empty() ? "(top level)" : l);
+  std::cout << "\nusing layer: " << (frame.layer.empty() ? "(top level)" : frame.layer) << "\npasses:\n";
+  for (const Pass& p : frame.passes) {
+    std::cout << "  " << role_name(p.role) << ": " << (p.name.empty() ? "(bare)" : p.name) << " [";
+    for (std::size_t i = 0; i < p.channels.size(); ++i) std::cout << (i ? " " : "") << p.channels[i];
+    std::cout << "]";
+    if (p.space != Space::None) std::cout << " " << space_name(p.space) << " space";
+    if (frame.find(p.role, Prefer::Feature) == &p) std::cout << " (used by feature filters)";
+    else if (frame.find(p.role, Prefer::Geometry) == &p) std::cout << " (used for geometry)";
+    std::cout << "\n";
+  }
+  if (!frame.extra.empty()) {
+    std::cout << "other channels:";
+    for (const Pass& p : frame.extra) std::cout << " " << (p.name.empty() ? "(bare)" : p.name) << "(" << p.channels.size() << ")";
+    std::cout << "\n";
+  }
+  std::cout << "filters:\n";
+  for (const auto& f : filters) {
+    std::cout << "  " << f["name"].get<std::string>() << ": " << (f["can_run"].get<bool>() ? "can run" : "cannot run, lacks");
+    for (const auto& m : f["missing"]) std::cout << " " << m.get<std::string>();
+    std::cout << "\n";
+  }
+  return 0;
+}
+
+}  // namespace
+
+Run add_info(CLI::App& app) {
+  auto a = std::make_shared<InfoArgs>();
+  app.add_option("input", a->input, "render (EXR, multilayer or plain; deep EXR)")->required();
+  app.add_option("--layer", a->layer, "view layer to use (default: the first with a colour pass)");
+  app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)");
+  app.add_flag("--json", a->json, "machine-readable output");
+  return [a] { return run_info(*a); };
+}
+
+}  // namespace mcr::cli

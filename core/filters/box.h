@@ -1,0 +1,17 @@
+#pragma once
+#include "filters/filter.h"
+
+namespace mcr {
+
+// Plain box filter: mean of the colour over a (2r+1)^2 window clipped at the
+// borders. The baseline every other filter must beat, and the I/O floor probe.
+class BoxFilter : public Filter {
+ public:
+  BoxFilter() : Filter(static_info()) {}
+  static const FilterInfo& static_info();
+
+ protected:
+  void run(const Frame& frame, const Roi& roi, Image& out, int nthreads) override;
+};
+
+}  // namespace mcr

@@ -1,0 +1,73 @@
+#pragma once
+// Filter interface (set -> commit -> execute), after OIDN's filter lifecycle.
+// Parameters live in a ParamSet built from the filter's one table; every input
+// check happens in commit() (parameters) and execute() (passes), nowhere else.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "filters/params.h"
+#include "image/pass.h"
+
+namespace mcr {
+
+struct FilterInfo {
+  std::string name;     // registry name, e.g. "box"
+  std::string summary;  // one line
+  std::string reference;  // paper / section it implements
+  ParamTable params;
+  std::vector<Role> required;  // passes it cannot run without
+  std::vector<Role> optional;  // passes it uses when present
+  bool temporal = false;       // keeps history between execute() calls (frame order matters)
+  std::string nonfinite_policy;  // what it does with NaN/Inf input, for docs and `filters`
+};
+
+struct ExecOptions {
+  Roi roi;           // empty = whole frame; pixels outside keep the input colour
+  int nthreads = 0;  // 0 = all cores
+};
+
+class Filter {
+ public:
+  explicit Filter(const FilterInfo& info);
+  virtual ~Filter() = default;
+
+  const FilterInfo& info() const { return info_; }
+  const ParamSet& params() const { return params_; }
+
+  void set(const std::string& name, const ParamValue& value);
+  void set_text(const std::string& name, const std::string& text);
+  // Validates cross-parameter constraints; execute() requires a committed filter.
+  void commit();
+
+  // Runs on one frame and returns its RGB result (same size as the frame).
+  // Throws MissingPass naming the passes the frame lacks.
+  Image execute(const Frame& frame, const ExecOptions& options = {});
+
+  // Drops temporal history (new shot, frames out of order).
+  virtual void reset() {}
+
+  // Passes in info().required that the frame lacks.
+  std::vector<Role> missing_passes(const Frame& frame) const;
+  // Notes from the last execute(), e.g. which optional weights were dropped.
+  const std::vector<std::string>& notes() const { return notes_; }
+  // Non-finite values the safety net replaced in the last execute(); a correct
+  // filter keeps this at 0 (tests check it).
+  std::size_t nonfinite_repaired() const { return repaired_; }
+
+ protected:
+  virtual void check_params() {}
+  // out arrives as a copy of the colour pass (RGB); write the result inside roi.
+  virtual void run(const Frame& frame, const Roi& roi, Image& out, int nthreads) = 0;
+  void note(std::string text) { notes_.push_back(std::move(text)); }
+
+  ParamSet params_;
+
+ private:
+  const FilterInfo& info_;
+  bool committed_ = false;
+  std::vector<std::string> notes_;
+  std::size_t repaired_ = 0;
+};
+
+}  // namespace mcr

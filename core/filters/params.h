@@ -1,0 +1,61 @@
+#pragma once
+// One parameter table per filter: name, type, default, range, help. The CLI,
+// the OIIO plugin, the Python module and the Blender UI are all generated from it.
+#include <cstdint>
+#include <map>
+#include <string>
+#include <variant>
+#include <vector>
+
+namespace mcr {
+
+enum class ParamType { Int, Float, Bool, Enum };
+const char* param_type_name(ParamType t);
+
+using ParamValue = std::variant<std::int64_t, double, bool, std::string>;
+
+struct ParamSpec {
+  std::string name;
+  ParamType type = ParamType::Float;
+  ParamValue default_value;
+  double min = 0, max = 0;           // inclusive range for Int and Float
+  std::vector<std::string> choices;  // Enum
+  std::string help;
+
+  static ParamSpec Int(std::string name, std::int64_t def, std::int64_t lo, std::int64_t hi, std::string help);
+  static ParamSpec Float(std::string name, double def, double lo, double hi, std::string help);
+  static ParamSpec Bool(std::string name, bool def, std::string help);
+  static ParamSpec Enum(std::string name, std::string def, std::vector<std::string> choices, std::string help);
+};
+
+using ParamTable = std::vector<ParamSpec>;
+
+// Values of a table, always complete (defaults filled in) and always valid:
+// every setter checks name, type and range and throws mcr::Error otherwise.
+class ParamSet {
+ public:
+  ParamSet() = default;
+  ParamSet(std::string owner, const ParamTable* table);
+
+  void set(const std::string& name, const ParamValue& value);
+  void set_text(const std::string& name, const std::string& text);  // parses by the spec's type
+  bool has(const std::string& name) const;
+
+  std::int64_t get_int(const std::string& name) const;
+  double get_float(const std::string& name) const;
+  bool get_bool(const std::string& name) const;
+  const std::string& get_enum(const std::string& name) const;
+  const std::map<std::string, ParamValue>& values() const { return values_; }
+
+ private:
+  const ParamSpec& spec(const std::string& name) const;
+  std::string owner_;
+  const ParamTable* table_ = nullptr;
+  std::map<std::string, ParamValue> values_;
+};
+
+std::string param_value_text(const ParamValue& v);  // "5", "0.25", "true", "gaussian"
+// "[0, 64]" for numbers, "one of: a, b" for enums, "" for bools.
+std::string param_range_text(const ParamSpec& s);
+
+}  // namespace mcr

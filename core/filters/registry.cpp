@@ -1,0 +1,47 @@
+#include "filters/registry.h"
+
+#include "filters/box.h"
+#include "util/error.h"
+
+namespace mcr {
+
+namespace {
+
+struct Entry {
+  const FilterInfo& (*info)();
+  std::unique_ptr<Filter> (*make)();
+};
+
+template <class F>
+Entry entry() {
+  return {&F::static_info, [] { return std::unique_ptr<Filter>(new F()); }};
+}
+
+const std::vector<Entry>& entries() {
+  static const std::vector<Entry> list = {
+      entry<BoxFilter>(),
+  };
+  return list;
+}
+
+const Entry& find(const std::string& name) {
+  for (const Entry& e : entries())
+    if (e.info().name == name) return e;
+  std::string known;
+  for (const Entry& e : entries()) known += (known.empty() ? "" : ", ") + e.info().name;
+  throw Error(Errc::UnknownFilter, "unknown filter '" + name + "' (available: " + known + ")");
+}
+
+}  // namespace
+
+std::vector<std::string> filter_names() {
+  std::vector<std::string> names;
+  for (const Entry& e : entries()) names.push_back(e.info().name);
+  return names;
+}
+
+const FilterInfo& filter_info(const std::string& name) { return find(name).info(); }
+
+std::unique_ptr<Filter> make_filter(const std::string& name) { return find(name).make(); }
+
+}  // namespace mcr

@@ -1,0 +1,230 @@
+#include "io/frame_reader.h"
+
+#include <OpenImageIO/deepdata.h>
+#include <OpenImageIO/imagebuf.h>
+#include <OpenImageIO/imagebufalgo.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <filesystem>
+#include <set>
+
+#include "io/channel_roles.h"
+#include "util/error.h"
+
+namespace mcr {
+
+namespace fs = std::filesystem;
+using namespace OIIO;
+
+namespace {
+
+// All channels of subimage 0 as interleaved float.
+struct RawImage {
+  int width = 0, height = 0;
+  std::vector<std::string> names;
+  std::vector<float> pixels;
+  std::shared_ptr<DeepSamples> deep;
+};
+
+void check_path(const std::string& path) {
+  std::error_code ec;
+  if (!fs::exists(path, ec)) throw Error(Errc::FileNotFound, "cannot read '" + path + "': no such file");
+  if (fs::is_directory(path, ec)) throw Error(Errc::NotAnImage, "cannot read '" + path + "': it is a directory");
+}
+
+std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec) {
+  auto deep = std::make_shared<DeepSamples>();
+  deep->width = spec.width;
+  deep->height = spec.height;
+  deep->channel_names.assign(spec.channelnames.begin(), spec.channelnames.end());
+  const std::int64_t np = std::int64_t(spec.width) * spec.height;
+  deep->offsets.assign(std::size_t(np) + 1, 0);
+  for (std::int64_t p = 0; p < np; ++p) deep->offsets[std::size_t(p) + 1] = deep->offsets[std::size_t(p)] + dd.samples(p);
+  deep->values.assign(std::size_t(spec.nchannels), std::vector<float>(deep->total_samples()));
+  for (int c = 0; c < spec.nchannels; ++c)
+    for (std::int64_t p = 0; p < np; ++p)
+      for (unsigned s = 0, n = dd.samples(p); s < n; ++s)
+        deep->values[std::size_t(c)][deep->offsets[std::size_t(p)] + s] = dd.deep_value(p, c, int(s));
+  return deep;
+}
+
+RawImage read_raw(const std::string& path) {
+  check_path(path);
+  auto in = ImageInput::open(path);
+  if (!in) {
+    std::string msg = OIIO::geterror();
+    throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
+  }
+  const ImageSpec spec = in->spec();
+  RawImage raw;
+  raw.width = spec.width;
+  raw.height = spec.height;
+  raw.names.assign(spec.channelnames.begin(), spec.channelnames.end());
+  const double bytes = double(spec.width) * spec.height * std::max(spec.nchannels, 1) * 4.0;
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || bytes > 32e9)
+    throw Error(Errc::ReadFailed, "cannot read '" + path + "': implausible size " + std::to_string(spec.width) +
+                                      "x" + std::to_string(spec.height) + "x" + std::to_string(spec.nchannels));
+  try {
+    if (spec.deep) {
+      in.reset();
+      ImageBuf deepbuf(path);
+      if (!deepbuf.read(0, 0, true, TypeFloat) || !deepbuf.deep())
+        throw Error(Errc::ReadFailed, "cannot read deep pixels of '" + path + "': " + deepbuf.geterror());
+      raw.deep = copy_deep(*deepbuf.deepdata(), deepbuf.spec());
+      // Flat passes of a deep file: front-to-back composite of every channel.
+      ImageBuf flat = ImageBufAlgo::flatten(deepbuf);
+      if (flat.has_error()) throw Error(Errc::ReadFailed, "cannot flatten deep '" + path + "': " + flat.geterror());
+      raw.names.assign(flat.spec().channelnames.begin(), flat.spec().channelnames.end());
+      raw.pixels.resize(std::size_t(spec.width) * spec.height * flat.nchannels());
+      flat.get_pixels(flat.roi(), TypeFloat, raw.pixels.data());
+    } else {
+      raw.pixels.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
+      if (!in->read_image(0, 0, 0, spec.nchannels, TypeFloat, raw.pixels.data()))
+        throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' (truncated or corrupt?): " + in->geterror());
+    }
+  } catch (const std::bad_alloc&) {
+    throw Error(Errc::ReadFailed, "cannot read '" + path + "': out of memory");
+  }
+  return raw;
+}
+
+Pass make_pass(const RawImage& raw, const std::string& path, const std::string& group_name, const RoleMatch& m) {
+  Pass p;
+  p.role = m.role;
+  p.name = group_name;
+  p.source = path;
+  p.space = m.space;
+  p.priority = m.priority;
+  const int nc = int(m.indices.size()), nin = int(raw.names.size());
+  for (int i : m.indices) p.channels.push_back(raw.names[std::size_t(i)]);
+  p.image = Image(raw.width, raw.height, nc);
+  float* dst = p.image.data();
+  const std::size_t n = std::size_t(raw.width) * raw.height;
+  for (std::size_t px = 0; px < n; ++px)
+    for (int c = 0; c < nc; ++c) dst[px * nc + c] = raw.pixels[px * nin + std::size_t(m.indices[std::size_t(c)])];
+  return p;
+}
+
+Pass group_as_pass(const RawImage& raw, const std::string& path, const ChannelGroup& g) {
+  RoleMatch all{Role::Colour, Space::None, 0, g.indices};
+  return make_pass(raw, path, g.name(), all);
+}
+
+std::string choose_layer(const std::vector<ChannelGroup>& groups, const std::vector<std::string>& layers,
+                         const std::string& wanted, const std::string& path) {
+  if (!wanted.empty()) {
+    if (std::find(layers.begin(), layers.end(), wanted) != layers.end()) return wanted;
+    std::string list;
+    for (const auto& l : layers) list += (list.empty() ? "" : ", ") + (l.empty() ? std::string("(none)") : l);
+    throw Error(Errc::MissingPass, "no layer '" + wanted + "' in '" + path + "' (layers: " + list + ")");
+  }
+  // The first view layer with a colour pass; the compositor's output is not a view layer.
+  for (int pass = 0; pass < 2; ++pass)
+    for (const ChannelGroup& g : groups) {
+      if (pass == 0 && (g.layer.empty() || g.layer == "Composite")) continue;
+      for (const RoleMatch& m : classify_group(g))
+        if (m.role == Role::Colour) return g.layer;
+    }
+  for (const auto& l : layers)
+    if (!l.empty() && l != "Composite") return l;
+  return layers.empty() ? "" : layers.front();
+}
+
+Pass resolve_override(const RawImage& raw, const std::vector<ChannelGroup>& groups, const std::string& layer,
+                      const std::string& path, const PassOverride& o) {
+  for (const ChannelGroup& g : groups) {
+    if (g.name() != o.value && !(g.layer == layer && g.pass == o.value)) continue;
+    if (auto m = force_role(g, o.role)) return make_pass(raw, path, g.name(), *m);
+    throw Error(Errc::MissingPass, "--pass " + std::string(role_name(o.role)) + "=" + o.value + ": channel group '" +
+                                       g.name() + "' in '" + path + "' has too few channels for " + role_name(o.role));
+  }
+  std::error_code ec;
+  if (fs::exists(o.value, ec)) return read_pass_file(o.value, o.role);
+  throw Error(Errc::MissingPass, "--pass " + std::string(role_name(o.role)) + "=" + o.value + ": no file '" + o.value +
+                                     "' and no channel group '" + o.value + "' in '" + path + "'");
+}
+
+}  // namespace
+
+PassOverride parse_pass_override(const std::string& text) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())
+    throw Error(Errc::InvalidArgument, "--pass expects ROLE=FILE or ROLE=CHANNEL_GROUP, got '" + text + "'");
+  const std::string role = text.substr(0, eq);
+  auto r = role_from_name(role);
+  if (!r) {
+    std::string list;
+    for (Role x : kAllRoles) list += (list.empty() ? "" : ", ") + std::string(role_name(x));
+    throw Error(Errc::InvalidArgument, "--pass: unknown role '" + role + "' (roles: " + list + ")");
+  }
+  return {*r, text.substr(eq + 1)};
+}
+
+Pass read_pass_file(const std::string& path, Role role) {
+  RawImage raw = read_raw(path);
+  const auto groups = group_channels(raw.names);
+  for (const ChannelGroup& g : groups)  // a pass of that role by name
+    for (const RoleMatch& m : classify_group(g))
+      if (m.role == role) return make_pass(raw, path, g.name(), m);
+  for (const ChannelGroup& g : groups)  // else the first group wide enough
+    if (auto m = force_role(g, role)) return make_pass(raw, path, g.name(), *m);
+  throw Error(Errc::MissingPass, "'" + path + "' has no channels usable as the " + role_name(role) + " pass");
+}
+
+Frame read_frame(const std::string& path, const ReadOptions& options) {
+  RawImage raw = read_raw(path);
+  Frame frame;
+  frame.width = raw.width;
+  frame.height = raw.height;
+  frame.path = path;
+  frame.deep = raw.deep;
+
+  const auto groups = group_channels(raw.names);
+  for (const ChannelGroup& g : groups)
+    if (std::find(frame.layers.begin(), frame.layers.end(), g.layer) == frame.layers.end()) frame.layers.push_back(g.layer);
+  frame.layer = choose_layer(groups, frame.layers, options.layer, path);
+
+  // Passes of the chosen layer, then top-level channels for roles still missing
+  // (an mcrecon output keeps R,G,B on top and the view layer's features below).
+  std::set<int> used;
+  std::vector<std::string> search = {frame.layer};
+  if (!frame.layer.empty()) search.push_back("");
+  for (const std::string& layer : search) {
+    std::set<Role> had;
+    for (const Pass& p : frame.passes) had.insert(p.role);
+    for (const ChannelGroup& g : groups) {
+      if (g.layer != layer) continue;
+      for (const RoleMatch& m : classify_group(g)) {
+        if (layer != frame.layer && had.count(m.role)) continue;
+        frame.passes.push_back(make_pass(raw, path, g.name(), m));
+        used.insert(m.indices.begin(), m.indices.end());
+      }
+    }
+  }
+  for (const PassOverride& o : options.overrides) {
+    Pass p = resolve_override(raw, groups, frame.layer, path, o);
+    frame.put(std::move(p));
+  }
+  if (options.keep_extra) {
+    for (const ChannelGroup& g : groups) {
+      ChannelGroup rest = g;
+      rest.indices.clear();
+      rest.suffixes.clear();
+      for (std::size_t i = 0; i < g.indices.size(); ++i)
+        if (!used.count(g.indices[i])) { rest.indices.push_back(g.indices[i]); rest.suffixes.push_back(g.suffixes[i]); }
+      if (!rest.indices.empty()) frame.extra.push_back(group_as_pass(raw, path, rest));
+    }
+  }
+  if (options.require_colour && !frame.has(Role::Colour)) {
+    std::string list;
+    for (const ChannelGroup& g : groups) list += (list.empty() ? "" : ", ") + (g.name().empty() ? std::string("(bare)") : g.name());
+    throw Error(Errc::MissingPass, "no colour pass in '" + path + "'" +
+                                       (frame.layer.empty() ? "" : " layer '" + frame.layer + "'") +
+                                       " (channel groups: " + list + "); name one with --pass colour=GROUP");
+  }
+  frame.check_sizes();
+  return frame;
+}
+
+}  // namespace mcr

@@ -1,0 +1,34 @@
+#pragma once
+// Reading a frame (colour + feature passes) with OpenImageIO.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "image/pass.h"
+
+namespace mcr {
+
+struct PassOverride {
+  Role role;
+  std::string value;  // a file (loose pass) or a channel group of the input ("ViewLayer.Normal")
+};
+
+struct ReadOptions {
+  std::string layer;                    // "" = the first view layer with a colour pass
+  std::vector<PassOverride> overrides;  // --pass ROLE=VALUE
+  bool require_colour = true;           // MissingPass when no colour pass is found
+  bool keep_extra = false;              // fill Frame::extra with every unused channel group
+};
+
+// Parses "normal=normals.exr" into an override; throws InvalidArgument.
+PassOverride parse_pass_override(const std::string& text);
+
+// Reads every pass of the file (deep files: the per-sample buffer plus the
+// flattened passes). Throws FileNotFound, NotAnImage, ReadFailed, MissingPass,
+// SizeMismatch, each naming the file and pass.
+Frame read_frame(const std::string& path, const ReadOptions& options = {});
+
+// A loose pass file or a plain image read as one pass of the given role.
+Pass read_pass_file(const std::string& path, Role role);
+
+}  // namespace mcr

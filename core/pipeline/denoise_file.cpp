@@ -1,0 +1,55 @@
+#include "pipeline/denoise_file.h"
+
+#include <chrono>
+
+#include "filters/registry.h"
+#include "util/error.h"
+
+namespace mcr {
+
+namespace {
+double ms_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+}
+}  // namespace
+
+std::pair<std::string, std::string> parse_key_value(const std::string& text, const std::string& option) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error(Errc::InvalidArgument, option + " expects KEY=VALUE, got '" + text + "'");
+  return {text.substr(0, eq), text.substr(eq + 1)};
+}
+
+DenoiseSession::DenoiseSession(const std::string& filter,
+                               const std::vector<std::pair<std::string, std::string>>& params)
+    : filter_(make_filter(filter)) {
+  for (const auto& kv : params) filter_->set_text(kv.first, kv.second);
+  filter_->commit();
+}
+
+StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
+                               const WriteOptions& write, const ExecOptions& exec) {
+  StageTimes t;
+  auto t0 = std::chrono::steady_clock::now();
+  const Frame frame = read_frame(input, read);
+  t.read_ms = ms_since(t0);
+
+  t0 = std::chrono::steady_clock::now();
+  const Image result = filter_->execute(frame, exec);
+  t.filter_ms = ms_since(t0);
+
+  if (!output.empty()) {
+    t0 = std::chrono::steady_clock::now();
+    WriteOptions w = write;
+    w.attributes.emplace_back("mcrecon:filter", filter_->info().name);
+    std::string params;
+    for (const auto& kv : filter_->params().values())
+      params += (params.empty() ? "" : " ") + kv.first + "=" + param_value_text(kv.second);
+    w.attributes.emplace_back("mcrecon:parameters", params);
+    write_result(output, result, frame, w);
+    t.write_ms = ms_since(t0);
+  }
+  return t;
+}
+
+}  // namespace mcr
