@@ -1,0 +1,23 @@
+#pragma once
+// Display-referred previews: linear RGB images side by side, through an
+// OpenColorIO display transform (Blender's config by default), written as PNG.
+#include <string>
+#include <vector>
+
+#include "image/image.h"
+
+namespace mcr {
+
+struct DisplayOptions {
+  std::string config = "/usr/share/blender/datafiles/colormanagement/config.ocio";
+  std::string display = "sRGB";
+  std::string view = "Standard";
+  std::string from = "Linear";  // scene-linear space of the renders in that config
+  int gap = 4;                  // pixels between tiles
+};
+
+// Writes tiles left to right (all the same height) as an 8-bit PNG via temp + rename.
+void write_side_by_side_png(const std::string& path, const std::vector<const Image*>& tiles,
+                            const DisplayOptions& options = {});
+
+}  // namespace mcr

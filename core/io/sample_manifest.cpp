@@ -1,0 +1,53 @@
+#include "io/sample_manifest.h"
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "util/error.h"
+
+namespace mcr {
+
+namespace fs = std::filesystem;
+
+std::string default_samples_dir() {
+  if (const char* env = std::getenv("MCRECON_SAMPLES")) return env;
+#ifdef MCRECON_SOURCE_DIR
+  return std::string(MCRECON_SOURCE_DIR) + "/samples/data";
+#else
+  return "samples/data";
+#endif
+}
+
+std::vector<SampleScene> load_sample_manifest(const std::string& dir) {
+  const fs::path file = fs::path(dir) / "manifest.json";
+  std::ifstream in(file);
+  if (!in) throw Error(Errc::FileNotFound, "cannot read sample manifest '" + file.string() + "'");
+  std::vector<SampleScene> scenes;
+  try {
+    const nlohmann::json j = nlohmann::json::parse(in);
+    for (const auto& s : j.at("scenes")) {
+      SampleScene sc;
+      sc.name = s.at("name").get<std::string>();
+      sc.kind = s.value("kind", std::string("still"));
+      sc.description = s.value("description", std::string());
+      sc.width = s.value("width", 0);
+      sc.height = s.value("height", 0);
+      for (const auto& [spp, path] : s.at("noisy").items())
+        sc.noisy[std::stoi(spp)] = (fs::path(dir) / path.get<std::string>()).string();
+      sc.reference = (fs::path(dir) / s.at("reference").get<std::string>()).string();
+      sc.reference_spp = s.value("reference_spp", 0);
+      if (s.contains("frames")) {
+        sc.first_frame = s.at("frames").at(0).get<int>();
+        sc.last_frame = s.at("frames").at(1).get<int>();
+      }
+      scenes.push_back(std::move(sc));
+    }
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(Errc::InvalidArgument, "malformed sample manifest '" + file.string() + "': " + e.what());
+  }
+  return scenes;
+}
+
+}  // namespace mcr
