@@ -13,7 +13,7 @@ const FilterInfo& BoxFilter::static_info() {
     i.name = "box";
     i.summary = "Box filter: unweighted mean over a square window";
     i.reference = "baseline";
-    i.params = {ParamSpec::Int("radius", 2, 0, 64, "half width of the window in pixels (window = 2r+1)")};
+    i.params = with_common_params({ParamSpec::Int("radius", 2, 0, 64, "half width of the window in pixels (window = 2r+1)")});
     i.required = {Role::Colour};
     i.nonfinite_policy =
         "a pixel with any non-finite RGB value is left out of every window; a window with no finite pixel gives 0";
@@ -22,8 +22,7 @@ const FilterInfo& BoxFilter::static_info() {
   return info;
 }
 
-void BoxFilter::run(const Frame& frame, const Roi& roi, Image& out, int nthreads) {
-  const Image& in = frame.image(Role::Colour);
+void BoxFilter::run(const Frame& frame, const Image& in, const Roi& roi, Image& out, int nthreads) {
   const int r = int(params_.get_int("radius"));
   const int w = frame.width, h = frame.height;
   // Rows the vertical pass reads, and their horizontal sums (RGB + count) in double:

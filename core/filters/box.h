@@ -11,7 +11,7 @@ class BoxFilter : public Filter {
   static const FilterInfo& static_info();
 
  protected:
-  void run(const Frame& frame, const Roi& roi, Image& out, int nthreads) override;
+  void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 };
 
 }  // namespace mcr

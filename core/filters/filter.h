@@ -22,6 +22,16 @@ struct FilterInfo {
   std::string nonfinite_policy;  // what it does with NaN/Inf input, for docs and `filters`
 };
 
+// Parameters every filter's table ends with; the base class applies them
+// around run(), so each filter gets them for free:
+//   demodulate   divide the colour by the albedo pass before filtering, multiply after
+//   albedo_floor albedo is clamped to [albedo_floor, 1] for that (Blender's albedo
+//                reaches ~0.03 on glossy metal and >100 near lights)
+//   holes        pixels the render did not sample, filled by pull-push (features too)
+//                before filtering: auto (sample_count == 0 when that pass exists),
+//                none, sample_count, alpha (alpha == 0)
+ParamTable with_common_params(ParamTable own);
+
 struct ExecOptions {
   Roi roi;           // empty = whole frame; pixels outside keep the input colour
   int nthreads = 0;  // 0 = all cores
@@ -57,8 +67,10 @@ class Filter {
 
  protected:
   virtual void check_params() {}
-  // out arrives as a copy of the colour pass (RGB); write the result inside roi.
-  virtual void run(const Frame& frame, const Roi& roi, Image& out, int nthreads) = 0;
+  // colour: the RGB input to filter (holes filled, demodulated when asked); read it,
+  // not frame's colour pass. frame: every pass (holes filled too). out arrives as a
+  // copy of colour; write the result inside roi.
+  virtual void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) = 0;
   void note(std::string text) { notes_.push_back(std::move(text)); }
 
   ParamSet params_;
