@@ -115,9 +115,9 @@ Run add_denoise(CLI::App& app) {
   app.add_option("input", a->input, "render or sequence pattern (shot_####.exr, shot_%04d.exr)")->required();
   app.add_option("-o,--output", a->output, "output EXR (a pattern for sequences)")->required();
   app.add_option("-f,--filter", a->filter, "filter name (see `mcrecon filters`)")->required();
-  app.add_option("-s,--set", a->sets, "filter parameter KEY=VALUE (repeatable)");
+  app.add_option("-s,--set", a->sets, "filter parameter KEY=VALUE (repeatable)")->allow_extra_args(false);
   app.add_option("--layer", a->layer, "view layer (default: the first with a colour pass)");
-  app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)");
+  app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)")->allow_extra_args(false);
   app.add_option("--frames", a->frames, "frame range A-B for a sequence pattern");
   app.add_option("--region", a->region, "only filter X0,Y0,X1,Y1 (end exclusive); the rest keeps the input");
   app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(CLI::NonNegativeNumber);

@@ -83,7 +83,7 @@ Run add_info(CLI::App& app) {
   auto a = std::make_shared<InfoArgs>();
   app.add_option("input", a->input, "render (EXR, multilayer or plain; deep EXR)")->required();
   app.add_option("--layer", a->layer, "view layer to use (default: the first with a colour pass)");
-  app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)");
+  app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)")->allow_extra_args(false);
   app.add_flag("--json", a->json, "machine-readable output");
   return [a] { return run_info(*a); };
 }

@@ -13,5 +13,6 @@ Run add_filters(CLI::App& app);
 Run add_denoise(CLI::App& app);
 Run add_compare(CLI::App& app);
 Run add_demo(CLI::App& app);
+Run add_sparsify(CLI::App& app);
 
 }  // namespace mcr::cli

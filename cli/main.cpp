@@ -36,6 +36,8 @@ int main(int argc, char** argv) {
   add("filters", "list every filter with its parameter table", mcr::cli::add_filters);
   add("denoise", "run a filter on a render or a sequence", mcr::cli::add_denoise);
   add("compare", "error metrics of an image against a reference", mcr::cli::add_compare);
+  add("sparsify", "subsample a render with the thesis' foveated expanded grid (holes for pull-push)",
+      mcr::cli::add_sparsify);
   add("demo", "run every filter on the sample scenes: table + side-by-side PNGs", mcr::cli::add_demo);
 
   try {

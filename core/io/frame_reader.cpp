@@ -119,13 +119,14 @@ std::string choose_layer(const std::vector<ChannelGroup>& groups, const std::vec
     for (const auto& l : layers) list += (list.empty() ? "" : ", ") + (l.empty() ? std::string("(none)") : l);
     throw Error(Errc::MissingPass, "no layer '" + wanted + "' in '" + path + "' (layers: " + list + ")");
   }
-  // The first view layer with a colour pass; the compositor's output is not a view layer.
-  for (int pass = 0; pass < 2; ++pass)
-    for (const ChannelGroup& g : groups) {
-      if (pass == 0 && (g.layer.empty() || g.layer == "Composite")) continue;
-      for (const RoleMatch& m : classify_group(g))
-        if (m.role == Role::Colour) return g.layer;
-    }
+  // The first view layer with a colour pass; the compositor's output is not a
+  // view layer. A named layer without colour still wins over the top level (an
+  // mcrecon output keeps R,G,B on top and the view layer's features below).
+  for (const ChannelGroup& g : groups) {
+    if (g.layer.empty() || g.layer == "Composite") continue;
+    for (const RoleMatch& m : classify_group(g))
+      if (m.role == Role::Colour) return g.layer;
+  }
   for (const auto& l : layers)
     if (!l.empty() && l != "Composite") return l;
   return layers.empty() ? "" : layers.front();
