@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "util/parallel.h"
 
@@ -17,6 +18,8 @@ const FilterInfo& BoxFilter::static_info() {
     i.required = {Role::Colour};
     i.nonfinite_policy =
         "a pixel with any non-finite RGB value is left out of every window; a window with no finite pixel gives 0";
+    i.sweep_param = "radius";
+    i.sweep_values = {1, 2, 3, 4, 6};
     return i;
   }();
   return info;
@@ -53,8 +56,10 @@ void BoxFilter::run(const Frame& frame, const Image& in, const Roi& roi, Image& 
       float* o = out.pixel(x, y);
       for (int c = 0; c < 3; ++c) {
         const double v = s[3] > 0 ? s[c] / s[3] : 0.0;
-        // The mean of finite floats can still overflow float (many 3e38 values).
-        o[c] = float(std::clamp(v, -3.0e38, 3.0e38));
+        // The mean of finite floats cannot exceed the largest float; clamp only
+        // the double rounding so the cast never gives inf.
+        constexpr double kMax = std::numeric_limits<float>::max();
+        o[c] = float(std::clamp(v, -kMax, kMax));
       }
     }
   });

@@ -20,6 +20,9 @@ struct FilterInfo {
   std::vector<Role> optional;  // passes it uses when present
   bool temporal = false;       // keeps history between execute() calls (frame order matters)
   std::string nonfinite_policy;  // what it does with NaN/Inf input, for docs and `filters`
+  // The main parameter and the values the run-time-against-error benchmark sweeps.
+  std::string sweep_param;
+  std::vector<double> sweep_values;
 };
 
 // Parameters every filter's table ends with; the base class applies them
