@@ -1,0 +1,155 @@
+#!/usr/bin/python3
+"""Check the rendered sample data against manifest.json and print quality tables.
+
+    /usr/bin/python3 samples/check_samples.py [--data samples/data] [--png DIR]
+
+Needs numpy and OpenImageIO (python3-openimageio: use Debian's /usr/bin/python3).
+Checks: every file listed exists and has the expected channels; no NaN/Inf in any channel;
+Combined is neither black nor blown out; the animation's Vector X/Y is non-zero on frames
+after the first. Prints relMSE = mean((x - r)^2 / (r^2 + 0.01)) over Combined RGB of every
+noisy level against its reference (per frame and averaged for the sequence), and the ratio
+between successive levels (about 4 for 4x the samples). Exit status 1 on any failure.
+"""
+import argparse
+import json
+import os
+import sys
+
+import numpy as np
+import OpenImageIO as oiio
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+RGB = ["ViewLayer.Combined.R", "ViewLayer.Combined.G", "ViewLayer.Combined.B"]
+failures = []
+
+
+def fail(msg):
+    failures.append(msg)
+    print("FAIL: " + msg)
+
+
+def read(path):
+    inp = oiio.ImageInput.open(path)
+    if inp is None:
+        fail(f"cannot open {path}: {oiio.geterror()}")
+        return None, None
+    spec = inp.spec()
+    pix = inp.read_image("float")
+    inp.close()
+    return list(spec.channelnames), pix
+
+
+def rel_mse(x, r):
+    return float(np.mean((x - r) ** 2 / (r * r + 0.01)))
+
+
+def combined(names, pix):
+    return pix[..., [names.index(c) for c in RGB]]
+
+
+def check_file(path, passes):
+    names, pix = read(path)
+    if names is None:
+        return None, None
+    for p in passes:
+        if not any(n.startswith(f"ViewLayer.{p}.") for n in names):
+            fail(f"{path}: no '{p}' pass")
+    bad = ~np.isfinite(pix)
+    if bad.any():
+        fail(f"{path}: {int(bad.sum())} NaN/Inf values in "
+             f"{sorted({names[i] for i in np.nonzero(bad.any(axis=(0, 1)))[0]})}")
+    rgb = combined(names, pix)
+    m = float(rgb.mean())
+    clipped = float((rgb.max(axis=2) > 1.0).mean())
+    if m < 0.03:
+        fail(f"{path}: too dark (mean {m:.4f})")
+    if m > 2.0 or clipped > 0.25:
+        fail(f"{path}: blown out (mean {m:.3f}, {clipped:.0%} of pixels above 1)")
+    return names, pix
+
+
+def frame_paths(data, pattern, frames):
+    return [(f, os.path.join(data, pattern.replace("####", f"{f:04d}")))
+            for f in range(frames[0], frames[1] + 1)]
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--data", default=os.path.join(HERE, "data"))
+    ap.add_argument("--png", default="", help="write sRGB previews of reference and 1/4 spp here")
+    args = ap.parse_args()
+    with open(os.path.join(args.data, "manifest.json")) as f:
+        manifest = json.load(f)
+
+    table = []  # (scene, spp, relMSE)
+    total_bytes = 0
+    for sc in manifest["scenes"]:
+        name, seq = sc["name"], sc["kind"] == "sequence"
+        frames = sc.get("frames", [1, 1])
+        ref_pat = sc["reference"]
+        refs = {}
+        for f, path in (frame_paths(args.data, ref_pat, frames) if seq
+                        else [(None, os.path.join(args.data, ref_pat))]):
+            names, pix = check_file(path, sc["reference_passes"])
+            total_bytes += os.path.getsize(path)
+            if names is not None:
+                refs[f] = combined(names, pix)
+                m = refs[f].mean(axis=(0, 1))
+                if f in (None, frames[0]):
+                    print(f"{name}: reference mean RGB {m[0]:.3f} {m[1]:.3f} {m[2]:.3f}")
+                if args.png and f in (None, frames[0]):
+                    png(path, args.png)
+        for spp, pat in sorted(sc["noisy"].items(), key=lambda kv: int(kv[0])):
+            errs, vec = [], []
+            for f, path in (frame_paths(args.data, pat, frames) if seq
+                            else [(None, os.path.join(args.data, pat))]):
+                names, pix = check_file(path, sc["noisy_passes"])
+                total_bytes += os.path.getsize(path)
+                if names is None:
+                    continue
+                if names[:4] != RGB + ["ViewLayer.Combined.A"]:
+                    fail(f"{path}: unexpected channel order {names[:4]}")
+                errs.append(rel_mse(combined(names, pix), refs[f]))
+                if seq:
+                    vx = np.abs(pix[..., names.index("ViewLayer.Vector.X")]).mean()
+                    vy = np.abs(pix[..., names.index("ViewLayer.Vector.Y")]).mean()
+                    vec.append((f, vx, vy))
+                    if f > frames[0] and (vx < 0.05 and vy < 0.05):
+                        fail(f"{path}: Vector pass is (nearly) zero: |X| {vx:.4f} |Y| {vy:.4f}")
+                if args.png and f in (None, frames[0]) and int(spp) <= 4:
+                    png(path, args.png)
+            table.append((name, int(spp), float(np.mean(errs)), len(errs)))
+            if vec and spp == min(sc["noisy"], key=int):
+                vx = np.array([v[1] for v in vec])
+                vy = np.array([v[2] for v in vec])
+                print(f"{name}: mean |Vector.X| per frame {vx.min():.2f}..{vx.max():.2f} px, "
+                      f"|Vector.Y| {vy.min():.2f}..{vy.max():.2f} px (frames "
+                      f"{vec[0][0]}..{vec[-1][0]})")
+
+    print("\n| scene | spp | relMSE | ratio to next level |")
+    print("|---|---:|---:|---:|")
+    for i, (name, spp, e, n) in enumerate(table):
+        nxt = table[i + 1] if i + 1 < len(table) and table[i + 1][0] == name else None
+        ratio = f"{e / nxt[2]:.2f} (x{nxt[1] // spp} spp)" if nxt else ""
+        frames_note = f" (mean of {n} frames)" if n > 1 else ""
+        print(f"| {name} | {spp} | {e:.5f}{frames_note} | {ratio} |")
+    print(f"\nchecked data: {total_bytes / 1e6:.1f} MB in the files listed by the manifest")
+    if failures:
+        print(f"{len(failures)} failure(s)")
+        return 1
+    print("all checks passed")
+    return 0
+
+
+def png(path, out_dir):
+    os.makedirs(out_dir, exist_ok=True)
+    buf = oiio.ImageBuf(path)
+    names = list(buf.spec().channelnames)
+    rgb = oiio.ImageBufAlgo.channels(buf, tuple(names.index(c) for c in RGB))
+    rgb = oiio.ImageBufAlgo.colorconvert(rgb, "linear", "sRGB")
+    out = os.path.join(out_dir, os.path.splitext(os.path.basename(path))[0] + ".png")
+    rgb.write(out, "uint8")
+
+
+if __name__ == "__main__":
+    sys.exit(main())
