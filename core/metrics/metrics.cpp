@@ -47,14 +47,23 @@ ErrorSums error_sums(const Image& ref, const Image& img, int nthreads) {
         }
       }
       double s[kLanes] = {}, r[kLanes] = {}, sc[kLanes] = {};
-      for (int i0 = 0; i0 < n; i0 += kLanes) {
-        for (int k = 0; k < kLanes && i0 + k < n; ++k) {
-          const double ai = a[i0 + k], bi = b[i0 + k];
+      const int full = n - n % kLanes;
+      for (int i = 0; i < full; i += kLanes) {
+        for (int k = 0; k < kLanes; ++k) {
+          const double ai = a[i + k], bi = b[i + k];
           const double d = bi - ai, dc = clamp01(bi) - clamp01(ai);
           s[k] += d * d;
           r[k] += d * d / (ai * ai + 0.01);
           sc[k] += dc * dc;
         }
+      }
+      for (int i = full; i < n; ++i) {
+        const int k = i - full;
+        const double ai = a[i], bi = b[i];
+        const double d = bi - ai, dc = clamp01(bi) - clamp01(ai);
+        s[k] += d * d;
+        r[k] += d * d / (ai * ai + 0.01);
+        sc[k] += dc * dc;
       }
       sq[y] = (s[0] + s[1]) + (s[2] + s[3]);
       rel[y] = (r[0] + r[1]) + (r[2] + r[3]);

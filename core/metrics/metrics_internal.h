@@ -1,10 +1,12 @@
 #pragma once
 // Private helpers shared by metrics.cpp and ssim.cpp; not part of the public API.
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
@@ -15,7 +17,7 @@ namespace mcr::metrics_detail {
 
 // NaN and +-Inf read as 0 (see metrics.h).
 inline double finite_or_zero(float v) { return std::isfinite(v) ? double(v) : 0.0; }
-inline double clamp01(double v) { return v < 0.0 ? 0.0 : (v > 1.0 ? 1.0 : v); }
+inline double clamp01(double v) { return std::min(std::max(v, 0.0), 1.0); }
 
 // Throws unless both images are non-empty, of equal size and have at least 3 channels.
 inline void check_pair(const Image& a, const Image& b, const char* what, const char* name_a,
@@ -36,11 +38,15 @@ inline void check_pair(const Image& a, const Image& b, const char* what, const c
 }
 
 // Runs fn(first, last) over [0, count) split into fixed blocks of `block` items, in parallel on
-// `nthreads` threads (<= 0: all cores). The split does not depend on the thread count.
+// `nthreads` threads (<= 0: all cores; more than TBB allows is capped, silently). The split
+// does not depend on the thread count.
 template <class Fn>
 void parallel_blocks(int count, int block, int nthreads, const Fn& fn) {
   const int nblocks = (count + block - 1) / block;
-  tbb::task_arena arena(nthreads > 0 ? nthreads : tbb::task_arena::automatic);
+  const int allowed =
+      int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
+  tbb::task_arena arena(nthreads > 0 ? (nthreads < allowed ? nthreads : allowed)
+                                     : tbb::task_arena::automatic);
   arena.execute([&] {
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nblocks, 1),

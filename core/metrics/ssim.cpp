@@ -106,7 +106,9 @@ class SsimBlock {
 
  private:
   static int slot(int v) { return ((v % kTaps) + kTaps) % kTaps; }
-  double* ring_row(int v, int m) { return ring_.data() + (std::size_t(slot(v)) * kMoments + m) * w_; }
+  double* ring_row(int v, int m) {
+    return ring_.data() + (std::size_t(slot(v)) * kMoments + m) * w_;
+  }
 
   // Horizontally filtered moments of virtual row v (reflected into the image) into the ring.
   void filter_row(int c, int v) {
@@ -127,7 +129,8 @@ class SsimBlock {
       pyy[j] = b * b;
       pxy[j] = a * b;
     }
-    for (int m = 0; m < kMoments; ++m) convolve_row(px + std::size_t(m) * pw, ring_row(v, m), w_, g_);
+    for (int m = 0; m < kMoments; ++m)
+      convolve_row(px + std::size_t(m) * pw, ring_row(v, m), w_, g_);
   }
 
   double ssim_row(int y) {
@@ -150,9 +153,15 @@ class SsimBlock {
       const double den = (mx[x] * mx[x] + my[x] * my[x] + kC1) * (sxx + syy + kC2);
       map[x] = num / den;
     }
-    double sum = 0.0;
-    for (int x = 0; x < w_; ++x) sum += map[x];
-    return sum;
+    // Fixed order: kLanes interleaved partial sums, then combined pairwise.
+    double part[kLanes] = {};
+    int x = 0;
+    for (; x + kLanes <= w_; x += kLanes)
+      for (int k = 0; k < kLanes; ++k) part[k] += map[x + k];
+    for (int k = 0; x < w_; ++x, ++k) part[k] += map[x];
+    for (int width = kLanes / 2; width > 0; width /= 2)
+      for (int k = 0; k < width; ++k) part[k] += part[k + width];
+    return part[0];
   }
 
   const Image& ref_;
