@@ -26,7 +26,12 @@ Roi parse_region(const std::string& text) {
   std::smatch m;
   if (!std::regex_match(text, m, re))
     throw Error(Errc::InvalidArgument, "--region expects X0,Y0,X1,Y1 (pixels, end exclusive), got '" + text + "'");
-  Roi r{std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3]), std::stoi(m[4])};
+  Roi r;
+  try {
+    r = {std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3]), std::stoi(m[4])};
+  } catch (const std::out_of_range&) {
+    throw Error(Errc::InvalidArgument, "--region '" + text + "': a coordinate is out of range");
+  }
   if (r.empty()) throw Error(Errc::InvalidArgument, "--region '" + text + "' is empty");
   return r;
 }
@@ -62,7 +67,12 @@ int run_denoise(const DenoiseArgs& a) {
     if (!is_sequence_pattern(a.output))
       throw Error(Errc::InvalidArgument, "output '" + a.output + "' must be a pattern (#### or %04d) for a sequence input");
     const FrameRange r = parse_frame_range(a.frames);
-    for (int f = r.first; f <= r.last; ++f) jobs.emplace_back(sequence_path(a.input, f), sequence_path(a.output, f));
+    for (long long f = r.first; f <= r.last; ++f) {  // long long: a range ending at INT_MAX ends
+      std::string in = sequence_path(a.input, int(f));
+      std::error_code ec;
+      if (!std::filesystem::exists(in, ec)) throw Error(Errc::FileNotFound, "cannot read '" + in + "': no such file");
+      jobs.emplace_back(std::move(in), sequence_path(a.output, int(f)));
+    }
   } else {
     if (!a.frames.empty()) throw Error(Errc::InvalidArgument, "--frames needs a sequence pattern (#### or %04d) as input");
     jobs.emplace_back(a.input, a.output);
@@ -75,7 +85,14 @@ int run_denoise(const DenoiseArgs& a) {
     if (!std::filesystem::exists(j.first, ec)) throw Error(Errc::FileNotFound, "cannot read '" + j.first + "': no such file");
     inputs.push_back(j.first);
   }
-  for (const auto& j : jobs) check_output_path(j.second, inputs);
+  // Loose pass files (--pass normal=n.exr) are inputs too.
+  for (const PassOverride& o : ro.overrides) {
+    std::error_code ec;
+    if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
+  }
+  std::vector<std::string> outputs;
+  for (const auto& j : jobs) outputs.push_back(j.second);
+  check_output_paths(outputs, inputs);
 
   const bool temporal = session.filter().info().temporal;
   Progress progress("denoise " + a.filter, int(jobs.size()));

@@ -179,9 +179,20 @@ void ParamSet::set_text(const std::string& name, const std::string& text) {
   }
 }
 
-std::int64_t ParamSet::get_int(const std::string& name) const { spec(name); return std::get<std::int64_t>(values_.at(name)); }
-double ParamSet::get_float(const std::string& name) const { spec(name); return std::get<double>(values_.at(name)); }
-bool ParamSet::get_bool(const std::string& name) const { spec(name); return std::get<bool>(values_.at(name)); }
-const std::string& ParamSet::get_enum(const std::string& name) const { spec(name); return std::get<std::string>(values_.at(name)); }
+namespace {
+// A getter of the wrong type is a bug in the filter: a typed Internal error, not std::bad_variant_access.
+template <class T>
+const T& typed_value(const std::map<std::string, ParamValue>& values, const std::string& owner, const ParamSpec& s,
+                     const char* wanted) {
+  if (const T* v = std::get_if<T>(&values.at(s.name))) return *v;
+  throw Error(Errc::Internal, "parameter '" + s.name + "' of filter '" + owner + "' is " + param_type_name(s.type) +
+                                  ", read as " + wanted);
+}
+}  // namespace
+
+std::int64_t ParamSet::get_int(const std::string& name) const { return typed_value<std::int64_t>(values_, owner_, spec(name), "int"); }
+double ParamSet::get_float(const std::string& name) const { return typed_value<double>(values_, owner_, spec(name), "float"); }
+bool ParamSet::get_bool(const std::string& name) const { return typed_value<bool>(values_, owner_, spec(name), "bool"); }
+const std::string& ParamSet::get_enum(const std::string& name) const { return typed_value<std::string>(values_, owner_, spec(name), "enum"); }
 
 }  // namespace mcr

@@ -1,10 +1,13 @@
 #include "io/atomic_write.h"
 
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <csignal>
 #include <cstring>
 #include <filesystem>
+#include <map>
+#include <utility>
 
 #include "util/error.h"
 
@@ -38,23 +41,42 @@ void remove_pending_temp() noexcept {
   if (g_has_pending) ::unlink(g_pending);
 }
 
-void check_output_path(const std::string& output, const std::vector<std::string>& inputs) {
-  if (output.empty()) throw Error(Errc::InvalidArgument, "no output path given");
-  std::error_code ec;
-  const fs::path out = fs::weakly_canonical(fs::absolute(output), ec);
+void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+  // Each input once (a sequence checks every output against every input): its
+  // canonical path, and its file identity when it exists (hard links).
+  std::map<fs::path, const std::string*> by_path;
+  std::map<std::pair<dev_t, ino_t>, const std::string*> by_id;
   for (const std::string& in : inputs) {
-    std::error_code ec2;
-    const fs::path p = fs::weakly_canonical(fs::absolute(in), ec2);
-    if ((!ec && !ec2 && p == out) || (fs::exists(in, ec2) && fs::exists(output, ec2) && fs::equivalent(in, output, ec2)))
-      throw Error(Errc::InvalidArgument, "output '" + output + "' is the input '" + in + "': inputs are never overwritten");
+    std::error_code ec;
+    const fs::path p = fs::weakly_canonical(fs::absolute(in), ec);
+    if (!ec) by_path.emplace(p, &in);
+    struct stat st;
+    if (::stat(in.c_str(), &st) == 0) by_id.emplace(std::make_pair(st.st_dev, st.st_ino), &in);
   }
-  fs::path dir = fs::absolute(output).parent_path();
-  if (!fs::is_directory(dir, ec))
-    throw Error(Errc::WriteFailed, "cannot write '" + output + "': directory '" + dir.string() + "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw Error(Errc::WriteFailed, "cannot write '" + output + "': directory '" + dir.string() + "' is not writable");
-  if (fs::is_directory(output, ec))
-    throw Error(Errc::WriteFailed, "cannot write '" + output + "': it is a directory");
+  for (const std::string& output : outputs) {
+    if (output.empty()) throw Error(Errc::InvalidArgument, "no output path given");
+    std::error_code ec;
+    const std::string* same = nullptr;
+    const fs::path out = fs::weakly_canonical(fs::absolute(output), ec);
+    if (!ec)
+      if (auto it = by_path.find(out); it != by_path.end()) same = it->second;
+    struct stat st;
+    if (!same && ::stat(output.c_str(), &st) == 0)
+      if (auto it = by_id.find(std::make_pair(st.st_dev, st.st_ino)); it != by_id.end()) same = it->second;
+    if (same)
+      throw Error(Errc::InvalidArgument, "output '" + output + "' is the input '" + *same + "': inputs are never overwritten");
+    fs::path dir = fs::absolute(output).parent_path();
+    if (!fs::is_directory(dir, ec))
+      throw Error(Errc::WriteFailed, "cannot write '" + output + "': directory '" + dir.string() + "' does not exist");
+    if (::access(dir.c_str(), W_OK) != 0)
+      throw Error(Errc::WriteFailed, "cannot write '" + output + "': directory '" + dir.string() + "' is not writable");
+    if (fs::is_directory(output, ec))
+      throw Error(Errc::WriteFailed, "cannot write '" + output + "': it is a directory");
+  }
+}
+
+void check_output_path(const std::string& output, const std::vector<std::string>& inputs) {
+  check_output_paths({output}, inputs);
 }
 
 void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std::string& format) {

@@ -11,6 +11,8 @@ namespace mcr {
 // Throws InvalidArgument when output is one of the inputs, WriteFailed when its
 // directory is missing or not writable. Call before any expensive work.
 void check_output_path(const std::string& output, const std::vector<std::string>& inputs);
+// The same for every output of a sequence, in n log n rather than outputs x inputs.
+void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
 
 // Writes buf to path through a temp file + rename; format from the extension
 // unless given ("openexr", "png"). Removes stale temps of earlier killed runs.

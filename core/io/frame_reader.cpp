@@ -188,9 +188,10 @@ Frame read_frame(const std::string& path, const ReadOptions& options) {
 
   // Passes of the chosen layer, then top-level channels for roles still missing
   // (an mcrecon output keeps R,G,B on top and the view layer's features below).
-  std::set<int> used;
+  // Then the compositor's output, so a file whose only Combined is Composite's still has a colour pass.
   std::vector<std::string> search = {frame.layer};
   if (!frame.layer.empty()) search.push_back("");
+  if (frame.layer != "Composite") search.push_back("Composite");
   for (const std::string& layer : search) {
     std::set<Role> had;
     for (const Pass& p : frame.passes) had.insert(p.role);
@@ -199,7 +200,6 @@ Frame read_frame(const std::string& path, const ReadOptions& options) {
       for (const RoleMatch& m : classify_group(g)) {
         if (layer != frame.layer && had.count(m.role)) continue;
         frame.passes.push_back(make_pass(raw, path, g.name(), m));
-        used.insert(m.indices.begin(), m.indices.end());
       }
     }
   }
@@ -208,12 +208,16 @@ Frame read_frame(const std::string& path, const ReadOptions& options) {
     frame.put(std::move(p));
   }
   if (options.keep_extra) {
+    // Channels of the passes finally in use; candidates an override replaced are extra.
+    std::set<std::string> used;
+    for (const Pass& p : frame.passes)
+      if (p.source == path) used.insert(p.channels.begin(), p.channels.end());
     for (const ChannelGroup& g : groups) {
       ChannelGroup rest = g;
       rest.indices.clear();
       rest.suffixes.clear();
       for (std::size_t i = 0; i < g.indices.size(); ++i)
-        if (!used.count(g.indices[i])) { rest.indices.push_back(g.indices[i]); rest.suffixes.push_back(g.suffixes[i]); }
+        if (!used.count(raw.names[std::size_t(g.indices[i])])) { rest.indices.push_back(g.indices[i]); rest.suffixes.push_back(g.suffixes[i]); }
       if (!rest.indices.empty()) frame.extra.push_back(group_as_pass(raw, path, rest));
     }
   }

@@ -1,0 +1,199 @@
+// ParamSet: parsing, types, ranges and unknown names, with their error codes and messages.
+#include "filters/params.h"
+
+#include <gtest/gtest.h>
+
+#include <limits>
+#include <string>
+
+#include "util/error.h"
+
+namespace mcr {
+namespace {
+
+const ParamTable& table() {
+  static const ParamTable t = {
+      ParamSpec::Int("radius", 2, 0, 64, "window half width"),
+      ParamSpec::Float("sigma", 0.5, 0.01, 10.0, "spatial sigma"),
+      ParamSpec::Bool("albedo", true, "use albedo"),
+      ParamSpec::Enum("kernel", "gauss", {"gauss", "box", "tent"}, "kernel shape"),
+  };
+  return t;
+}
+
+ParamSet params() { return ParamSet("testfilter", &table()); }
+
+// Runs fn, expects mcr::Error with that code, returns the message.
+template <class Fn>
+std::string expect_error(Errc code, Fn&& fn) {
+  try {
+    fn();
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), code) << "got " << errc_name(e.code()) << ": " << e.what();
+    return e.what();
+  } catch (const std::exception& e) {
+    ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", got std::exception: " << e.what();
+    return "";
+  }
+  ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", nothing thrown";
+  return "";
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+TEST(ParamsTest, DefaultsAreFilledIn) {
+  const ParamSet p = params();
+  EXPECT_EQ(p.get_int("radius"), 2);
+  EXPECT_DOUBLE_EQ(p.get_float("sigma"), 0.5);
+  EXPECT_TRUE(p.get_bool("albedo"));
+  EXPECT_EQ(p.get_enum("kernel"), "gauss");
+  EXPECT_EQ(p.values().size(), 4u);
+  EXPECT_TRUE(p.has("radius"));
+  EXPECT_FALSE(p.has("nosuch"));
+}
+
+TEST(ParamsTest, SetTextParsesEachType) {
+  ParamSet p = params();
+  p.set_text("radius", "7");
+  p.set_text("sigma", "2.25");
+  p.set_text("albedo", "off");
+  p.set_text("kernel", "tent");
+  EXPECT_EQ(p.get_int("radius"), 7);
+  EXPECT_DOUBLE_EQ(p.get_float("sigma"), 2.25);
+  EXPECT_FALSE(p.get_bool("albedo"));
+  EXPECT_EQ(p.get_enum("kernel"), "tent");
+  p.set_text("radius", "5.0");  // an integral float is an int
+  EXPECT_EQ(p.get_int("radius"), 5);
+  p.set_text("sigma", "3");  // an int is a float
+  EXPECT_DOUBLE_EQ(p.get_float("sigma"), 3.0);
+  for (const char* t : {"1", "true", "TRUE", "on", "yes"}) {
+    p.set_text("albedo", t);
+    EXPECT_TRUE(p.get_bool("albedo")) << t;
+  }
+  for (const char* t : {"0", "false", "Off", "no"}) {
+    p.set_text("albedo", t);
+    EXPECT_FALSE(p.get_bool("albedo")) << t;
+  }
+}
+
+TEST(ParamsTest, RangeEndsAreInclusive) {
+  ParamSet p = params();
+  p.set_text("radius", "0");
+  EXPECT_EQ(p.get_int("radius"), 0);
+  p.set_text("radius", "64");
+  EXPECT_EQ(p.get_int("radius"), 64);
+  p.set_text("sigma", "0.01");
+  p.set_text("sigma", "10");
+  EXPECT_DOUBLE_EQ(p.get_float("sigma"), 10.0);
+}
+
+TEST(ParamsTest, UnknownNameNamesParameterFilterAndKnownNames) {
+  ParamSet p = params();
+  std::string msg = expect_error(Errc::UnknownParameter, [&] { p.set_text("nosuch", "1"); });
+  EXPECT_TRUE(contains(msg, "'nosuch'")) << msg;
+  EXPECT_TRUE(contains(msg, "'testfilter'")) << msg;
+  EXPECT_TRUE(contains(msg, "radius")) << msg;
+  msg = expect_error(Errc::UnknownParameter, [&] { p.set("Radius", std::int64_t(1)); });  // names are exact
+  EXPECT_TRUE(contains(msg, "'Radius'")) << msg;
+  expect_error(Errc::UnknownParameter, [&] { p.get_int("nosuch"); });
+  expect_error(Errc::UnknownParameter, [&] { p.get_float(""); });
+}
+
+TEST(ParamsTest, FilterWithoutParametersSaysSo) {
+  static const ParamTable empty;
+  ParamSet p("plain", &empty);
+  const std::string msg = expect_error(Errc::UnknownParameter, [&] { p.set_text("radius", "1"); });
+  EXPECT_TRUE(contains(msg, "'plain'")) << msg;
+  EXPECT_TRUE(contains(msg, "takes none")) << msg;
+}
+
+TEST(ParamsTest, OutOfRangeNamesParameterFilterRangeAndValue) {
+  ParamSet p = params();
+  std::string msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("radius", "-1"); });
+  EXPECT_TRUE(contains(msg, "'radius'")) << msg;
+  EXPECT_TRUE(contains(msg, "'testfilter'")) << msg;
+  EXPECT_TRUE(contains(msg, "[0, 64]")) << msg;
+  EXPECT_TRUE(contains(msg, "-1")) << msg;
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("radius", "1000"); });
+  EXPECT_TRUE(contains(msg, "1000")) << msg;
+  expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("radius", "65"); });
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("sigma", "0.001"); });
+  EXPECT_TRUE(contains(msg, "'sigma'")) << msg;
+  expect_error(Errc::ParameterOutOfRange, [&] { p.set("sigma", 10.5); });
+  expect_error(Errc::ParameterOutOfRange, [&] { p.set("radius", std::int64_t(-5)); });
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("kernel", "median"); });
+  EXPECT_TRUE(contains(msg, "'kernel'")) << msg;
+  EXPECT_TRUE(contains(msg, "median")) << msg;
+  EXPECT_TRUE(contains(msg, "gauss, box, tent")) << msg;
+}
+
+TEST(ParamsTest, BadValuesNameParameterTypeAndText) {
+  ParamSet p = params();
+  std::string msg = expect_error(Errc::BadParameterValue, [&] { p.set_text("radius", "abc"); });
+  EXPECT_TRUE(contains(msg, "'radius'")) << msg;
+  EXPECT_TRUE(contains(msg, "'testfilter'")) << msg;
+  EXPECT_TRUE(contains(msg, "int")) << msg;
+  EXPECT_TRUE(contains(msg, "'abc'")) << msg;
+  for (const char* t : {"", "2.5", "3x", "nan", "inf", "1e400", "--2"})
+    expect_error(Errc::BadParameterValue, [&] { p.set_text("radius", t); });
+  for (const char* t : {"", "abc", "nan", "inf", "-inf", "1e999", "0.5.5"})
+    expect_error(Errc::BadParameterValue, [&] { p.set_text("sigma", t); });
+  msg = expect_error(Errc::BadParameterValue, [&] { p.set_text("albedo", "maybe"); });
+  EXPECT_TRUE(contains(msg, "'albedo'")) << msg;
+  EXPECT_TRUE(contains(msg, "bool")) << msg;
+  expect_error(Errc::BadParameterValue, [&] { p.set_text("albedo", "2"); });
+}
+
+TEST(ParamsTest, TypedSetChecksTheType) {
+  ParamSet p = params();
+  expect_error(Errc::BadParameterValue, [&] { p.set("radius", std::string("3")); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("radius", 2.5); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("radius", true); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("sigma", std::string("1")); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("sigma", std::numeric_limits<double>::quiet_NaN()); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("albedo", std::int64_t(2)); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("albedo", 1.0); });
+  expect_error(Errc::BadParameterValue, [&] { p.set("kernel", std::int64_t(1)); });
+  // Conversions that lose nothing are accepted.
+  p.set("radius", 4.0);
+  EXPECT_EQ(p.get_int("radius"), 4);
+  p.set("sigma", std::int64_t(2));
+  EXPECT_DOUBLE_EQ(p.get_float("sigma"), 2.0);
+  p.set("albedo", std::int64_t(0));
+  EXPECT_FALSE(p.get_bool("albedo"));
+}
+
+TEST(ParamsTest, FailedSetKeepsThePreviousValue) {
+  ParamSet p = params();
+  p.set_text("radius", "9");
+  expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("radius", "100"); });
+  expect_error(Errc::BadParameterValue, [&] { p.set_text("radius", "x"); });
+  EXPECT_EQ(p.get_int("radius"), 9);
+  expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("kernel", "nope"); });
+  EXPECT_EQ(p.get_enum("kernel"), "gauss");
+}
+
+TEST(ParamsTest, GetterOfTheWrongTypeIsATypedError) {
+  const ParamSet p = params();
+  const std::string msg = expect_error(Errc::Internal, [&] { p.get_float("radius"); });
+  EXPECT_TRUE(contains(msg, "'radius'")) << msg;
+  expect_error(Errc::Internal, [&] { p.get_int("sigma"); });
+  expect_error(Errc::Internal, [&] { p.get_enum("albedo"); });
+  expect_error(Errc::Internal, [&] { p.get_bool("kernel"); });
+}
+
+TEST(ParamsTest, TextForms) {
+  EXPECT_EQ(param_value_text(ParamValue(std::int64_t(5))), "5");
+  EXPECT_EQ(param_value_text(ParamValue(0.25)), "0.25");
+  EXPECT_EQ(param_value_text(ParamValue(true)), "true");
+  EXPECT_EQ(param_value_text(ParamValue(std::string("gauss"))), "gauss");
+  EXPECT_EQ(param_range_text(table()[0]), "[0, 64]");
+  EXPECT_EQ(param_range_text(table()[1]), "[0.01, 10]");
+  EXPECT_EQ(param_range_text(table()[2]), "");
+  EXPECT_EQ(param_range_text(table()[3]), "one of: gauss, box, tent");
+  EXPECT_STREQ(param_type_name(ParamType::Int), "int");
+  EXPECT_STREQ(param_type_name(ParamType::Enum), "enum");
+}
+
+}  // namespace
+}  // namespace mcr
