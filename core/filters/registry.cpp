@@ -1,6 +1,7 @@
 #include "filters/registry.h"
 
 #include "filters/box.h"
+#include "filters/pwaf.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -20,6 +21,7 @@ Entry entry() {
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> list = {
       entry<BoxFilter>(),
+      entry<PwafFilter>(),
   };
   return list;
 }

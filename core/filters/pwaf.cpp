@@ -1,0 +1,620 @@
+#include "filters/pwaf.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <type_traits>
+
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+constexpr double kFloatMax = double(std::numeric_limits<float>::max());
+// Exponents are clamped here so that sums of huge terms stay finite (no inf - inf).
+constexpr double kMaxExponent = 1e300;
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
+
+bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
+
+Roi grown(const Roi& r, int by, int w, int h) {
+  return Roi{std::max(0, r.x0 - by), std::max(0, r.y0 - by), std::min(w, r.x1 + by), std::min(h, r.y1 + by)};
+}
+
+// A geometric feature pass and its Gaussian's 1 / (2 sigma^2).
+struct Feature {
+  const Image* image = nullptr;  // nullptr: the weight is dropped
+  double inv2s2 = 0;             // sigma in the feature's units (scaled, for positions)
+};
+
+// Reads the first 3 channels of a feature pixel (the last one repeated if fewer); false when
+// one is not finite.
+bool feature_at(const Image& im, int x, int y, float v[3]) {
+  const float* p = im.pixel(x, y);
+  const int nc = im.channels();
+  for (int c = 0; c < 3; ++c) v[c] = p[std::min(c, nc - 1)];
+  return finite3(v);
+}
+
+Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing) {
+  Feature f;
+  if (!pass) return f;
+  f.image = &pass->image;
+  const Image& im = pass->image;
+  const int w = im.width(), h = im.height();
+  double scale = 1.0;
+  if (scale_by_spacing) {
+    // Positions are in scene units: sigma is given in units of the frame's median distance
+    // between horizontally or vertically adjacent pixels (non-zero distances of finite pairs),
+    // so one default fits any scene scale. Computed over the whole frame, whatever the roi.
+    std::vector<double> d;
+    d.reserve(std::size_t(w) * h * 2);
+    auto dist = [&](int x0, int y0, int x1, int y1) {
+      float a[3], b[3];
+      if (!feature_at(im, x0, y0, a) || !feature_at(im, x1, y1, b)) return;
+      double s = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double t = double(a[c]) - double(b[c]);
+        s += t * t;
+      }
+      if (s > 0) d.push_back(std::sqrt(s));
+    };
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (x + 1 < w) dist(x, y, x + 1, y);
+        if (y + 1 < h) dist(x, y, x, y + 1);
+      }
+    if (!d.empty()) {
+      std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
+      scale = d[d.size() / 2];
+    }
+  }
+  const double s = sigma * scale;
+  f.inv2s2 = 1.0 / (2.0 * s * s);
+  if (!std::isfinite(f.inv2s2)) f.inv2s2 = kMaxExponent;  // sigma*scale underflowed: any difference stops
+  return f;
+}
+
+// exp(-d) for d in [0, 40]: 2^-(d log2 e) split into 2^n (exponent bits) times 2^f,
+// |f| <= 1/2, with e^(f ln 2) by its Taylor series to degree 11 (relative error < 1e-14).
+// Several times faster than std::exp and the same on every machine.
+inline double exp_neg(double d) {
+  const double t = -d * 1.4426950408889634;  // log2(e)
+  const double n = -double(std::int64_t(0.5 - t));  // round half up, t <= 0
+  const double x = (t - n) * 0.6931471805599453;  // ln 2, |x| <= 0.347
+  double p = 1.0 / 39916800.0;
+  p = p * x + 1.0 / 3628800.0;
+  p = p * x + 1.0 / 362880.0;
+  p = p * x + 1.0 / 40320.0;
+  p = p * x + 1.0 / 5040.0;
+  p = p * x + 1.0 / 720.0;
+  p = p * x + 1.0 / 120.0;
+  p = p * x + 1.0 / 24.0;
+  p = p * x + 1.0 / 6.0;
+  p = p * x + 0.5;
+  p = p * x + 1.0;
+  p = p * x + 1.0;
+  const std::int64_t bits = (std::int64_t(n) + 1023) << 52;  // n in [-58, 0]: a normal double
+  double scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  return p * scale;
+}
+
+inline double dist2(const float* a, const float* b) {
+  const double d0 = double(a[0]) - double(b[0]), d1 = double(a[1]) - double(b[1]), d2 = double(a[2]) - double(b[2]);
+  return d0 * d0 + d1 * d1 + d2 * d2;
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------------------------
+// Building blocks
+
+namespace pwaf {
+
+double luminance(const float* rgb) { return 0.2126 * double(rgb[0]) + 0.7152 * double(rgb[1]) + 0.0722 * double(rgb[2]); }
+
+double relative_variance(double variance, double lum) { return variance / (lum * lum + 0.01); }
+
+int window_radius(double rel_variance, double rho_max, int min_r, int max_r) {
+  if (!(rel_variance >= 0) || !std::isfinite(rel_variance)) return max_r;
+  if (!(rho_max > 0)) return rel_variance > 0 ? max_r : min_r;
+  const double t = std::clamp(rel_variance / rho_max, 0.0, 1.0);
+  return min_r + int(std::lround(t * double(max_r - min_r)));
+}
+
+OutlierResult suppress_outliers(const Image& colour, int radius, double k, const Roi& region, int nthreads) {
+  const int w = colour.width(), h = colour.height();
+  OutlierResult res;
+  res.colour = colour;
+  res.valid.assign(std::size_t(w) * h, 1);
+  res.replaced.assign(std::size_t(w) * h, 0);
+  if (region.empty()) return res;
+  // Luminance of every pixel the windows read, NaN where a channel is not finite.
+  const Roi lr = grown(region, radius, w, h);
+  const int lw = lr.width();
+  std::vector<double> lum(std::size_t(lw) * lr.height());
+  parallel_rows(lr.y0, lr.y1, nthreads, [&](int y) {
+    for (int x = lr.x0; x < lr.x1; ++x) {
+      const float* q = colour.pixel(x, y);
+      lum[std::size_t(y - lr.y0) * lw + (x - lr.x0)] = finite3(q) ? luminance(q) : std::numeric_limits<double>::quiet_NaN();
+    }
+  });
+  parallel_rows(region.y0, region.y1, nthreads, [&](int y) {
+    const int y0 = std::max(0, y - radius), y1 = std::min(h - 1, y + radius);
+    for (int x = region.x0; x < region.x1; ++x) {
+      const int x0 = std::max(0, x - radius), x1 = std::min(w - 1, x + radius);
+      const double lp = lum[std::size_t(y - lr.y0) * lw + (x - lr.x0)];
+      const bool finite = !std::isnan(lp);
+      // Mean and standard deviation (two passes) of the finite neighbours, centre excluded.
+      double mu = 0;
+      std::size_t n = 0;
+      for (int yy = y0; yy <= y1; ++yy) {
+        const double* row = &lum[std::size_t(yy - lr.y0) * lw - lr.x0];
+        for (int xx = x0; xx <= x1; ++xx)
+          if (!std::isnan(row[xx]) && (xx != x || yy != y)) { mu += row[xx]; ++n; }
+      }
+      const std::size_t i = std::size_t(y) * w + x;
+      float* o = res.colour.pixel(x, y);
+      std::uint8_t why = 0;
+      if (!finite) {
+        if (n == 0) {
+          o[0] = o[1] = o[2] = 0.0f;
+          res.valid[i] = 0;
+          continue;
+        }
+        why = 2;
+      } else if (k > 0 && n >= 3) {
+        mu /= double(n);
+        double var = 0;
+        for (int yy = y0; yy <= y1; ++yy) {
+          const double* row = &lum[std::size_t(yy - lr.y0) * lw - lr.x0];
+          for (int xx = x0; xx <= x1; ++xx)
+            if (!std::isnan(row[xx]) && (xx != x || yy != y)) var += (row[xx] - mu) * (row[xx] - mu);
+        }
+        const double excess = lp - mu;
+        if (excess > k * std::sqrt(var / double(n)) && excess > 0.01 * std::fabs(mu)) why = 1;
+      }
+      if (!why) continue;
+      // Replace by the mean RGB of the same neighbours.
+      double sum[3] = {0, 0, 0};
+      for (int yy = y0; yy <= y1; ++yy)
+        for (int xx = x0; xx <= x1; ++xx) {
+          if (xx == x && yy == y) continue;
+          const float* q = colour.pixel(xx, yy);
+          if (!finite3(q)) continue;
+          for (int c = 0; c < 3; ++c) sum[c] += double(q[c]);
+        }
+      for (int c = 0; c < 3; ++c) o[c] = float(std::clamp(sum[c] / double(n), -kFloatMax, kFloatMax));
+      res.replaced[i] = why;
+    }
+  });
+  return res;
+}
+
+std::vector<double> estimate_variance(const Image& colour, const std::vector<std::uint8_t>& valid,
+                                      const Image* sample_count, int radius, const Roi& region, int nthreads) {
+  const int w = colour.width(), h = colour.height();
+  std::vector<double> v(std::size_t(w) * h, 0.0);
+  if (region.empty()) return v;
+  auto inv_n = [&](int x, int y) {
+    if (!sample_count) return 1.0;
+    const double n = double(sample_count->pixel(x, y)[0]);
+    return std::isfinite(n) && n > 1.0 ? 1.0 / n : 1.0;
+  };
+  // Residuals on the region grown by the window radius.
+  const Roi e_reg = grown(region, radius, w, h);
+  const int ew = e_reg.width();
+  std::vector<double> e2(std::size_t(ew) * e_reg.height(), 0.0);  // mean over RGB of e_c^2
+  std::vector<double> a(e2.size(), 0.0);                           // its expected value / s^2
+  parallel_rows(e_reg.y0, e_reg.y1, nthreads, [&](int y) {
+    for (int x = e_reg.x0; x < e_reg.x1; ++x) {
+      if (!valid[std::size_t(y) * w + x]) continue;
+      double mean[3] = {0, 0, 0}, sum_inv = 0;
+      int m = 0;
+      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
+        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
+          if ((xx == x && yy == y) || !valid[std::size_t(yy) * w + xx]) continue;
+          const float* q = colour.pixel(xx, yy);
+          for (int c = 0; c < 3; ++c) mean[c] += double(q[c]);
+          sum_inv += inv_n(xx, yy);
+          ++m;
+        }
+      if (m == 0) continue;
+      const float* p = colour.pixel(x, y);
+      double s = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double r = double(p[c]) - mean[c] / m;
+        s += r * r;
+      }
+      const std::size_t j = std::size_t(y - e_reg.y0) * ew + (x - e_reg.x0);
+      e2[j] = s / 3.0;
+      a[j] = inv_n(x, y) + sum_inv / (double(m) * double(m));
+    }
+  });
+  // Window sums, separable (rows, then columns), each a direct sum: no running sums whose
+  // cancellation a 1e30 neighbour could spoil.
+  std::vector<double> re(std::size_t(region.width()) * e_reg.height()), ra(re.size());
+  const int rw = region.width();
+  parallel_rows(e_reg.y0, e_reg.y1, nthreads, [&](int y) {
+    const std::size_t row = std::size_t(y - e_reg.y0) * ew;
+    for (int x = region.x0; x < region.x1; ++x) {
+      double se = 0, sa = 0;
+      for (int xx = std::max(e_reg.x0, x - radius); xx <= std::min(e_reg.x1 - 1, x + radius); ++xx) {
+        se += e2[row + (xx - e_reg.x0)];
+        sa += a[row + (xx - e_reg.x0)];
+      }
+      re[std::size_t(y - e_reg.y0) * rw + (x - region.x0)] = se;
+      ra[std::size_t(y - e_reg.y0) * rw + (x - region.x0)] = sa;
+    }
+  });
+  parallel_rows(region.y0, region.y1, nthreads, [&](int y) {
+    for (int x = region.x0; x < region.x1; ++x) {
+      double se = 0, sa = 0;
+      for (int yy = std::max(e_reg.y0, y - radius); yy <= std::min(e_reg.y1 - 1, y + radius); ++yy) {
+        se += re[std::size_t(yy - e_reg.y0) * rw + (x - region.x0)];
+        sa += ra[std::size_t(yy - e_reg.y0) * rw + (x - region.x0)];
+      }
+      const double s2 = sa > 0 ? se / sa : 0.0;
+      v[std::size_t(y) * w + x] = std::isfinite(s2) ? s2 * inv_n(x, y) : std::numeric_limits<double>::max();
+    }
+  });
+  return v;
+}
+
+}  // namespace pwaf
+
+// ---------------------------------------------------------------------------------------------
+// The filter
+
+const FilterInfo& PwafFilter::static_info() {
+  static const FilterInfo info = [] {
+    FilterInfo i;
+    i.name = "pwaf";
+    i.summary = "Point-wise adaptive cross-bilateral filter: window radius per pixel from its colour variance";
+    i.reference = "Guo & Pan 2012, Point-wise Adaptive Filtering for Fast Monte Carlo Noise Reduction (eq. 8, 3.2, 3.3)";
+    i.params = with_common_params({
+        ParamSpec::Int("min_radius", 3, 0, 32, "window half width for the least noisy pixels"),
+        ParamSpec::Int("max_radius", 8, 0, 32, "window half width for pixels at or above variance_max (and everywhere when adaptive=false)"),
+        ParamSpec::Bool("adaptive", true, "per-pixel window radius from the colour variance; false = max_radius everywhere (Table 1's fixed windows)"),
+        ParamSpec::Float("variance_max", 6.0, 1e-6, 1e6,
+                         "the radius reaches max_radius at this multiple of the frame's median relative variance v/(Y^2+0.01); linear below"),
+        ParamSpec::Float("sigma_p", 3.0, 0.1, 1e6, "Gp: spatial standard deviation in pixels"),
+        ParamSpec::Float("sigma_c", 1.0, 1e-3, 1e6, "Gc: colour standard deviation in units of the pixel's noise standard deviation sqrt(v)"),
+        ParamSpec::Float("sigma_n", 0.1, 1e-4, 1e6, "Gn: first-hit normal standard deviation (normal units)"),
+        ParamSpec::Float("sigma_sp", 8.0, 1e-4, 1e6, "Gsp: second-hit (fallback: first-hit) position standard deviation, in median adjacent-pixel distances of that pass"),
+        ParamSpec::Float("sigma_sn", 0.5, 1e-4, 1e6, "Gsn: second-hit normal standard deviation (normal units)"),
+        ParamSpec::Float("prefilter_sigma", 1.0, 0.0, 8.0, "estimated range value: fixed Gaussian (pixels) over the outlier-suppressed colour; 0 = the pixel's own value"),
+        ParamSpec::Float("outlier_k", 5.0, 0.0, 1e3, "a pixel is an outlier when its luminance exceeds its neighbours' mean by k standard deviations (and by 1%); 0 = off"),
+        ParamSpec::Int("outlier_radius", 3, 1, 8, "outlier statistics window half width"),
+        ParamSpec::Int("variance_radius", 3, 1, 16, "half width of the window that clusters the variance (estimate or pass)"),
+    });
+    i.required = {Role::Colour};
+    i.optional = {Role::Normal, Role::Position, Role::SecondPosition, Role::SecondNormal, Role::Variance, Role::SampleCount};
+    i.nonfinite_policy =
+        "colour pixels with a NaN/Inf channel are replaced by the mean of the finite pixels of their outlier window "
+        "(left out of every window and output 0 only when that window has none); a non-finite feature value switches "
+        "that feature's Gaussian off (factor 1) for every pair that involves the pixel; a non-finite or negative "
+        "variance-pass value is ignored (the estimate is used where none is left); all arithmetic is in double and "
+        "outputs are clamped to the float range, so no NaN/Inf is ever produced";
+    return i;
+  }();
+  return info;
+}
+
+void PwafFilter::check_params() {
+  if (params_.get_int("min_radius") > params_.get_int("max_radius"))
+    throw Error(Errc::InvalidArgument, "filter 'pwaf': min_radius (" + std::to_string(params_.get_int("min_radius")) +
+                                           ") must not exceed max_radius (" + std::to_string(params_.get_int("max_radius")) + ")");
+}
+
+void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
+  stats_ = PwafStats{};
+  const int w = frame.width, h = frame.height;
+  const int min_r = int(params_.get_int("min_radius")), max_r = int(params_.get_int("max_radius"));
+  const bool adaptive = params_.get_bool("adaptive");
+  const double variance_max = params_.get_float("variance_max");
+  const double sigma_p = params_.get_float("sigma_p"), sigma_c = params_.get_float("sigma_c");
+  const double pf_sigma = params_.get_float("prefilter_sigma");
+  const double outlier_k = params_.get_float("outlier_k");
+  const int os_r = int(params_.get_int("outlier_radius")), var_r = int(params_.get_int("variance_radius"));
+  const int pf_r = pf_sigma > 0 ? int(std::ceil(3.0 * pf_sigma)) : 0;
+
+  // ---- SS: outlier replacement, variance, radius per pixel ----
+  const auto t_ss = Clock::now();
+  // `stat`: where the variance, the range value and the radius are needed -- the roi, or the
+  // whole frame when adaptive (the radius mapping is normalised by the frame's median). Every
+  // stage runs on what the next one reads and each value depends only on the input, so a roi
+  // gives the same pixels as the whole frame, and tiles agree at their seams.
+  const Roi stat = adaptive ? Roi::all(w, h) : roi;
+  const Roi support = grown(stat, std::max({max_r, pf_r, var_r + 1}), w, h);
+  pwaf::OutlierResult os = pwaf::suppress_outliers(colour, os_r, outlier_k, support, nthreads);
+  for (int y = support.y0; y < support.y1; ++y)
+    for (int x = support.x0; x < support.x1; ++x) {
+      const std::uint8_t r = os.replaced[std::size_t(y) * w + x];
+      stats_.outliers_replaced += r == 1;
+      stats_.nonfinite_replaced += r == 2;
+    }
+  const Image& in = os.colour;
+  const std::vector<std::uint8_t>& valid = os.valid;
+
+  // Variance: the pass (mean of its channels, averaged over the variance window, invalid values
+  // skipped) when present; the estimate where the pass is absent or has nothing valid near.
+  std::vector<double> variance(std::size_t(w) * h, 0.0);
+  const Pass* vpass = frame.find(Role::Variance);
+  const Pass* spp = frame.find(Role::SampleCount);
+  if (vpass) {
+    stats_.variance_from_pass = true;
+    const Image& vi = vpass->image;
+    const int vc = std::min(3, vi.channels());
+    // With demodulate=true the colour was divided by the albedo (clamped as the base class
+    // does): the variance of I_c / a_c is Var(I_c) / a_c^2, so the pass is divided likewise
+    // (a 1-channel pass by the mean of 1 / a_c^2).
+    const Pass* albedo = params_.get_bool("demodulate") ? frame.find(Role::Albedo) : nullptr;
+    const float floor = float(params_.get_float("albedo_floor"));
+    auto inv_a2 = [&](int x, int y, int c) {
+      if (!albedo) return 1.0;
+      const Image& ai = albedo->image;
+      const float v = ai.pixel(x, y)[std::min(c, ai.channels() - 1)];
+      const double a = std::isfinite(v) ? double(std::clamp(v, floor, 1.0f)) : 1.0;
+      return 1.0 / (a * a);
+    };
+    const Roi vreg = grown(stat, var_r, w, h);
+    const int vw = vreg.width();
+    std::vector<double> pv(std::size_t(vw) * vreg.height(), -1.0);  // -1: invalid
+    parallel_rows(vreg.y0, vreg.y1, nthreads, [&](int y) {
+      for (int x = vreg.x0; x < vreg.x1; ++x) {
+        const float* p = vi.pixel(x, y);
+        double s = 0;
+        bool ok = true;
+        for (int c = 0; c < vc; ++c) {
+          ok = ok && std::isfinite(p[c]) && p[c] >= 0.0f;
+          if (vc == 3) s += double(p[c]) * inv_a2(x, y, c);
+          else s += double(p[c]) * (inv_a2(x, y, 0) + inv_a2(x, y, 1) + inv_a2(x, y, 2)) / 3.0;
+        }
+        if (ok && std::isfinite(s)) pv[std::size_t(y - vreg.y0) * vw + (x - vreg.x0)] = s / vc;
+      }
+    });
+    std::vector<std::uint8_t> need_estimate(std::size_t(w) * h, 0);
+    parallel_rows(stat.y0, stat.y1, nthreads, [&](int y) {
+      for (int x = stat.x0; x < stat.x1; ++x) {
+        double s = 0;
+        int n = 0;
+        for (int yy = std::max(vreg.y0, y - var_r); yy <= std::min(vreg.y1 - 1, y + var_r); ++yy)
+          for (int xx = std::max(vreg.x0, x - var_r); xx <= std::min(vreg.x1 - 1, x + var_r); ++xx) {
+            const double q = pv[std::size_t(yy - vreg.y0) * vw + (xx - vreg.x0)];
+            if (q >= 0) { s += q; ++n; }
+          }
+        const std::size_t i = std::size_t(y) * w + x;
+        if (n > 0 && std::isfinite(s)) variance[i] = s / n;
+        else need_estimate[i] = 1;
+      }
+    });
+    if (std::find(need_estimate.begin(), need_estimate.end(), 1) != need_estimate.end()) {
+      const std::vector<double> est = pwaf::estimate_variance(in, valid, spp ? &spp->image : nullptr, var_r, stat, nthreads);
+      for (std::size_t i = 0; i < variance.size(); ++i)
+        if (need_estimate[i]) variance[i] = est[i];
+      note("pwaf: variance pass has no valid value around some pixels; variance estimated there from the image");
+    }
+  } else {
+    variance = pwaf::estimate_variance(in, valid, spp ? &spp->image : nullptr, var_r, stat, nthreads);
+    note(std::string("pwaf: no variance pass; variance estimated from high-pass residuals over ") +
+         std::to_string(2 * var_r + 1) + "x" + std::to_string(2 * var_r + 1) + " windows" +
+         (spp ? ", per sample, divided by the sample count" : ""));
+  }
+  stats_.ss_ms = ms_since(t_ss);
+
+  // ---- OS: estimated range value (fixed Gaussian of the outlier-suppressed colour) ----
+  const auto t_os = Clock::now();
+  Image est(w, h, 3, 0.0f);
+  {
+    std::vector<double> g(std::size_t(pf_r) + 1);
+    for (int d = 0; d <= pf_r; ++d) g[std::size_t(d)] = pf_sigma > 0 ? std::exp(-0.5 * d * d / (pf_sigma * pf_sigma)) : 1.0;
+    // Separable: g(dx) g(dy) factorises and validity is per pixel, so rows then columns give
+    // the 2-D valid-weighted sum.
+    const int hy0 = std::max(0, stat.y0 - pf_r), hy1 = std::min(h, stat.y1 + pf_r), sw = stat.width();
+    std::vector<double> hs(std::size_t(hy1 - hy0) * sw * 4);
+    parallel_rows(hy0, hy1, nthreads, [&](int y) {
+      for (int x = stat.x0; x < stat.x1; ++x) {
+        double s[4] = {0, 0, 0, 0};
+        for (int xx = std::max(0, x - pf_r); xx <= std::min(w - 1, x + pf_r); ++xx) {
+          if (!valid[std::size_t(y) * w + xx]) continue;
+          const double gw = g[std::size_t(std::abs(xx - x))];
+          const float* q = in.pixel(xx, y);
+          for (int c = 0; c < 3; ++c) s[c] += gw * double(q[c]);
+          s[3] += gw;
+        }
+        std::copy(s, s + 4, &hs[(std::size_t(y - hy0) * sw + (x - stat.x0)) * 4]);
+      }
+    });
+    parallel_rows(stat.y0, stat.y1, nthreads, [&](int y) {
+      for (int x = stat.x0; x < stat.x1; ++x) {
+        double s[4] = {0, 0, 0, 0};
+        for (int yy = std::max(0, y - pf_r); yy <= std::min(h - 1, y + pf_r); ++yy) {
+          const double gw = g[std::size_t(std::abs(yy - y))];
+          const double* q = &hs[(std::size_t(yy - hy0) * sw + (x - stat.x0)) * 4];
+          for (int c = 0; c < 4; ++c) s[c] += gw * q[c];
+        }
+        float* e = est.pixel(x, y);
+        for (int c = 0; c < 3; ++c) e[c] = s[3] > 0 ? float(std::clamp(s[c] / s[3], -kFloatMax, kFloatMax)) : 0.0f;
+      }
+    });
+  }
+  stats_.os_ms = ms_since(t_os);
+
+  // Radius per pixel (SS in the paper's breakdown; it needs the range value). 3.2: linear in the
+  // relative variance rho = v / (Y^2 + 0.01), reaching max_radius at variance_max times the
+  // frame's median rho, so that one default serves quiet and very noisy renders alike.
+  const auto t_ss2 = Clock::now();
+  std::vector<int> radius(std::size_t(w) * h, max_r);
+  if (adaptive) {
+    std::vector<double> rho(std::size_t(w) * h, 0.0);
+    parallel_rows(0, h, nthreads, [&](int y) {
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = std::size_t(y) * w + x;
+        rho[i] = pwaf::relative_variance(variance[i], pwaf::luminance(est.pixel(x, y)));
+      }
+    });
+    std::vector<double> sorted;
+    sorted.reserve(rho.size());
+    for (std::size_t i = 0; i < rho.size(); ++i)
+      if (valid[i] && std::isfinite(rho[i])) sorted.push_back(rho[i]);
+    double median = 0;
+    if (!sorted.empty()) {
+      std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
+      median = sorted[sorted.size() / 2];
+    }
+    stats_.median_rel_variance = median;
+    const double rho_max = variance_max * median;
+    for (int y = roi.y0; y < roi.y1; ++y)
+      for (int x = roi.x0; x < roi.x1; ++x) {
+        const std::size_t i = std::size_t(y) * w + x;
+        radius[i] = pwaf::window_radius(rho[i], rho_max, min_r, max_r);
+      }
+  }
+  double radius_sum = 0;
+  for (int y = roi.y0; y < roi.y1; ++y)
+    for (int x = roi.x0; x < roi.x1; ++x) radius_sum += radius[std::size_t(y) * w + x];
+  stats_.mean_radius = radius_sum / double(std::size_t(roi.width()) * roi.height());
+  stats_.ss_ms += ms_since(t_ss2);
+
+  // ---- FF: the feature-preserving filter, eq. 1 with the weight of eq. 8 ----
+  const auto t_ff = Clock::now();
+  const Pass* normal = frame.find(Role::Normal);
+  const Pass* pos2 = frame.find(Role::SecondPosition);
+  const Pass* nrm2 = frame.find(Role::SecondNormal);
+  const Pass* pos1 = frame.find(Role::Position, Prefer::Geometry);
+  if (!normal) note("pwaf: no normal pass; Gn dropped");
+  if (!pos2 && pos1) note("pwaf: no second_position pass; Gsp uses the first-hit position pass instead");
+  if (!pos2 && !pos1) note("pwaf: no second_position or position pass; Gsp dropped");
+  if (!nrm2) note("pwaf: no second_normal pass; Gsn dropped (the first-hit normal is already in Gn)");
+  const Feature fn = make_feature(normal, params_.get_float("sigma_n"), false);
+  const Feature fsp = make_feature(pos2 ? pos2 : pos1, params_.get_float("sigma_sp"), true);
+  const Feature fsn = make_feature(nrm2, params_.get_float("sigma_sn"), false);
+  const Feature* used[3];
+  double inv[3] = {0, 0, 0};
+  int nf = 0;
+  for (const Feature* f : {&fn, &fsp, &fsn})
+    if (f->image) {
+      inv[nf] = f->inv2s2;
+      used[nf++] = f;
+    }
+  // Everything the inner loop reads, packed per pixel of the roi grown by max_radius: colour,
+  // then the used features (3 floats each, non-finite ones zeroed); mask bit 0 = valid colour,
+  // bit k+1 = feature k finite.
+  const int stride = 3 + 3 * nf;
+  const Roi fr = grown(roi, max_r, w, h);
+  const int fw = fr.width();
+  std::vector<float> pk(std::size_t(fw) * fr.height() * stride, 0.0f);
+  std::vector<std::uint8_t> mask(std::size_t(fw) * fr.height(), 0);
+  parallel_rows(fr.y0, fr.y1, nthreads, [&](int y) {
+    for (int x = fr.x0; x < fr.x1; ++x) {
+      const std::size_t i = std::size_t(y - fr.y0) * fw + (x - fr.x0);
+      float* d = &pk[i * stride];
+      std::copy(in.pixel(x, y), in.pixel(x, y) + 3, d);
+      std::uint8_t m = valid[std::size_t(y) * w + x] ? 1 : 0;
+      for (int k = 0; k < nf; ++k) {
+        float v[3];
+        if (feature_at(*used[k]->image, x, y, v)) {
+          std::copy(v, v + 3, d + 3 + 3 * k);
+          m = std::uint8_t(m | (2 << k));
+        }
+      }
+      mask[i] = m;
+    }
+  });
+
+  // Gp exponent per |dx|, |dy|.
+  const int R = max_r;
+  std::vector<double> spatial(std::size_t(R + 1) * (R + 1));
+  for (int dy = 0; dy <= R; ++dy)
+    for (int dx = 0; dx <= R; ++dx) spatial[std::size_t(dy) * (R + 1) + dx] = 0.5 * (dx * dx + dy * dy) / (sigma_p * sigma_p);
+
+  // One pixel: the exponent of every valid neighbour (first pass), then the weights relative
+  // to the largest one (second pass): the same mean, and never 0/0. NF, the number of feature
+  // Gaussians, is a template argument so the feature loop unrolls.
+  auto filter_rows = [&](auto nf_tag) {
+    constexpr int NF = decltype(nf_tag)::value;
+    constexpr std::size_t S = 3 + 3 * NF;  // == stride
+    parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
+      std::vector<double> ex(std::size_t(2 * R + 1) * (2 * R + 1));
+      std::vector<std::size_t> at(ex.size());
+      for (int x = roi.x0; x < roi.x1; ++x) {
+        const std::size_t i = std::size_t(y) * w + x;
+        const int r = radius[i];
+        const float* ip = est.pixel(x, y);
+        const double ic[3] = {ip[0], ip[1], ip[2]};
+        // Gc against the estimated range value, sigma_c(p)^2 = sigma_c^2 v(p) + (1e-3 Y(p))^2 +
+        // 1e-300: the pixel's noise level sets the colour scale (3.3); the floors keep a
+        // noise-free pixel from dividing by zero.
+        const double yl = pwaf::luminance(ip);
+        const double sc2 = sigma_c * sigma_c * std::min(variance[i], 1e300) + 1e-6 * yl * yl + 1e-300;
+        const double kc = 1.0 / (6.0 * sc2);  // mean over the 3 channels, then 1/(2 sigma^2)
+        const std::size_t ip_k = std::size_t(y - fr.y0) * fw + (x - fr.x0);
+        const float* fp = &pk[ip_k * S];
+        const unsigned mp = mask[ip_k];
+        std::size_t n = 0;
+        double emin = std::numeric_limits<double>::infinity();
+        const int y0 = std::max(0, y - r), y1 = std::min(h - 1, y + r);
+        const int x0 = std::max(0, x - r), x1 = std::min(w - 1, x + r);
+        for (int yy = y0; yy <= y1; ++yy) {
+          const double* sp_row = &spatial[std::size_t(std::abs(yy - y)) * (R + 1)];
+          const std::size_t row = std::size_t(yy - fr.y0) * fw;
+          for (int xx = x0; xx <= x1; ++xx) {
+            const std::size_t j = row + std::size_t(xx - fr.x0);
+            const unsigned mq = mask[j];
+            if (!(mq & 1u)) continue;
+            const float* q = &pk[j * S];
+            const double d0 = double(q[0]) - ic[0], d1 = double(q[1]) - ic[1], d2 = double(q[2]) - ic[2];
+            double e = sp_row[std::abs(xx - x)] + (d0 * d0 + d1 * d1 + d2 * d2) * kc;
+            const unsigned both = mp & mq;
+            for (int k = 0; k < NF; ++k)
+              if (both & (2u << k)) e += dist2(fp + 3 + 3 * k, q + 3 + 3 * k) * inv[k];
+            e = std::min(e, kMaxExponent);
+            ex[n] = e;
+            at[n] = j;
+            ++n;
+            emin = std::min(emin, e);
+          }
+        }
+        float* o = out.pixel(x, y);
+        if (n == 0) {
+          o[0] = o[1] = o[2] = 0.0f;  // no valid pixel in the window
+          continue;
+        }
+        // Weights below e^-40 of the largest change the mean by < 1e-14: skipped.
+        double s0 = 0, s1 = 0, s2 = 0, sw = 0;
+        for (std::size_t k = 0; k < n; ++k) {
+          const double d = ex[k] - emin;
+          if (d > 40.0) continue;
+          const double wgt = exp_neg(d);
+          const float* q = &pk[at[k] * S];
+          s0 += wgt * double(q[0]);
+          s1 += wgt * double(q[1]);
+          s2 += wgt * double(q[2]);
+          sw += wgt;
+        }
+        o[0] = float(std::clamp(s0 / sw, -kFloatMax, kFloatMax));
+        o[1] = float(std::clamp(s1 / sw, -kFloatMax, kFloatMax));
+        o[2] = float(std::clamp(s2 / sw, -kFloatMax, kFloatMax));
+      }
+    });
+  };
+  switch (nf) {
+    case 0: filter_rows(std::integral_constant<int, 0>{}); break;
+    case 1: filter_rows(std::integral_constant<int, 1>{}); break;
+    case 2: filter_rows(std::integral_constant<int, 2>{}); break;
+    default: filter_rows(std::integral_constant<int, 3>{}); break;
+  }
+  stats_.ff_ms = ms_since(t_ff);
+}
+
+}  // namespace mcr
