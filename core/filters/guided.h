@@ -1,0 +1,84 @@
+#pragma once
+// Guided image filter (He, Sun & Tang 2013, Algorithm 1) with a multi-channel
+// guide built from feature passes, as Bauszat et al. 2011 use it for path traced
+// images (guide = 3 normal channels + depth) and as the BMFR paper (Koskela et al.
+// 2019, section 7) extends it to any number of feature buffers.
+//
+// Per output colour channel c and every window w_k (the (2r+1)^2 square around
+// pixel k, clipped at the image border, holding only the valid pixels):
+//   a_k = (Sigma_k + eps I)^-1 cov_k(z, p_c)   Sigma_k: d x d covariance of the guide z
+//   b_k = mean_k(p_c) - a_k . mean_k(z)
+// i.e. the ridge regression min sum_{i in w_k} [(a.z_i + b - p_i)^2 + eps |a|^2] of
+// He et al.'s eq. 3 (eps per pixel, so n_k eps |a|^2 for n_k valid pixels; Sigma and
+// cov carry the 1/n_k). The output is the plain average over the
+// windows that contain pixel i (centres k inside the image, within r of i, with at
+// least one valid pixel): q_i = mean_k (a_k . z_i + b_k).
+//
+// Guide normalisation (so that one eps fits every guide): every guide channel is
+// centred on its mean over the frame, then divided by a scale shared by the channels
+// of one pass (normal xyz, position xyz, albedo rgb, colour rgb share theirs):
+//   normal, albedo          s = max(1, rms std)  unit quantities keep their own scale
+//   depth, position,        s = rms std          metric quantities: unit variance
+//   luminance, colour                            (s = 1 when that std is 0)
+// where rms std = sqrt(mean over the pass's channels of the variance), mean and
+// variance taken over the pixels where every guide channel is finite, over the whole
+// frame (not the roi). Since s >= std, every normalised value is bounded by
+// sqrt(3 N) for N pixels, which keeps the moment sums well conditioned.
+//
+// Cost: O(N) for any radius. Box sums are running sums in double over one stacked
+// image (count, d means, d(d+1)/2 second moments, 3 colour means, 3d cross moments),
+// vertical then horizontal; the coefficients (3d slopes, 3 offsets, the count, and
+// the window mean colours when some pixel has no finite guide) go through the same
+// running sums a second time. The work is cut into row bands whose height depends
+// on the radius and the roi only (max(256, min(16r, roi height / 2)) rows), never on
+// the thread count, so every thread count gives the same bits; each band recomputes
+// r coefficient rows past each of its ends.
+//
+// Running sums forget rounding error only where they restart, so a pixel far
+// brighter than the rest of the frame (a firefly of 1e30 among values near 1) would
+// otherwise leave its rounding error behind in every later window: colour values at
+// or above 2^20 times the power of two just above the 90th percentile of the nonzero
+// |colour| go into their own set of sums (and the coefficients of the windows holding
+// them into their own coefficient sums). Every set of sums has its own count and
+// restarts at exactly 0 when that count is 0, so pixels farther than 2r from an
+// outlier never see it, and a pixel with no valid pixel nearby sees nothing.
+// The d x d systems (Sigma + eps I) are solved by an LDL^T factorisation with the
+// pivots floored at eps (exact arithmetic never gives a smaller one; the floor
+// catches rounding and NaN). Per-pixel work runs on GCC vectors of doubles.
+#include <cstddef>
+#include <vector>
+
+#include "filters/filter.h"
+
+namespace mcr {
+
+// What the last execute() did, for tests and --verbose tools.
+struct GuidedStats {
+  int guide_channels = 0;          // d
+  std::vector<double> guide_mean;  // per guide channel, over the frame
+  std::vector<double> guide_scale; // per guide channel (shared within a pass)
+  double outlier_threshold = 0;    // |colour| at or above it goes to the outlier sums (inf: none)
+  std::size_t outlier_pixels = 0;  // in the frame
+  std::size_t invalid_pixels = 0;  // non-finite colour or guide, in the frame
+  int bands = 0;                   // row bands the roi was cut into
+};
+
+class GuidedFilter : public Filter {
+ public:
+  GuidedFilter() : Filter(static_info()) {}
+  static const FilterInfo& static_info();
+  const GuidedStats& stats() const { return stats_; }
+
+  // The passes a guide choice reads ("normal_depth" -> normal, depth); colour-based
+  // guides (luminance, colour) read none. Throws BadParameterValue for unknown names.
+  static std::vector<Role> guide_passes(const std::string& guide);
+
+ protected:
+  void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
+
+ private:
+  GuidedStats stats_;
+  std::vector<std::vector<double>> work_;  // per row band, kept between calls
+};
+
+}  // namespace mcr
