@@ -744,6 +744,8 @@ const FilterInfo& GuidedFilter::static_info() {
         "inputs up to FLT_MAX never overflow. Fireflies: the guided filter spreads a bright pixel over the windows "
         "holding it (up to 2r away, like a box filter); colour values >= 2^20 x the 90th percentile of |colour| "
         "have sums of their own, so pixels farther than 2r never see their rounding error; clamp limits them";
+    i.sweep_param = "radius";
+    i.sweep_values = {2, 4, 8, 12, 16, 24};
     return i;
   }();
   return info;

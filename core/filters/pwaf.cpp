@@ -305,6 +305,8 @@ const FilterInfo& PwafFilter::static_info() {
         "that feature's Gaussian off (factor 1) for every pair that involves the pixel; a non-finite or negative "
         "variance-pass value is ignored (the estimate is used where none is left); all arithmetic is in double and "
         "outputs are clamped to the float range, so no NaN/Inf is ever produced";
+    i.sweep_param = "max_radius";
+    i.sweep_values = {4, 6, 8, 12};
     return i;
   }();
   return info;
