@@ -173,8 +173,9 @@ Pass read_pass_file(const std::string& path, Role role) {
   throw Error(Errc::MissingPass, "'" + path + "' has no channels usable as the " + role_name(role) + " pass");
 }
 
-Frame read_frame(const std::string& path, const ReadOptions& options) {
-  RawImage raw = read_raw(path);
+namespace {
+
+Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOptions& options) {
   Frame frame;
   frame.width = raw.width;
   frame.height = raw.height;
@@ -230,6 +231,27 @@ Frame read_frame(const std::string& path, const ReadOptions& options) {
   }
   frame.check_sizes();
   return frame;
+}
+
+}  // namespace
+
+Frame read_frame(const std::string& path, const ReadOptions& options) {
+  return frame_from_raw(read_raw(path), path, options);
+}
+
+Frame frame_from_channels(const std::string& path, int width, int height, const std::vector<std::string>& channel_names,
+                          std::vector<float> pixels, const ReadOptions& options) {
+  const std::size_t expected = std::size_t(std::max(width, 0)) * std::size_t(std::max(height, 0)) * channel_names.size();
+  if (width <= 0 || height <= 0 || channel_names.empty() || pixels.size() != expected)
+    throw Error(Errc::Internal, "frame_from_channels: " + std::to_string(pixels.size()) + " values for " +
+                                    std::to_string(width) + "x" + std::to_string(height) + "x" +
+                                    std::to_string(channel_names.size()) + " channels of '" + path + "'");
+  RawImage raw;
+  raw.width = width;
+  raw.height = height;
+  raw.names = channel_names;
+  raw.pixels = std::move(pixels);
+  return frame_from_raw(raw, path, options);
 }
 
 }  // namespace mcr

@@ -28,6 +28,13 @@ PassOverride parse_pass_override(const std::string& text);
 // SizeMismatch, each naming the file and pass.
 Frame read_frame(const std::string& path, const ReadOptions& options = {});
 
+// The same frame from channels already in memory (interleaved float, one name per
+// channel, as read_frame would find them in `path`, which names them in messages):
+// same layer choice, roles, overrides and checks. For front ends that receive
+// pixels rather than a file (the OpenImageIO output plugin).
+Frame frame_from_channels(const std::string& path, int width, int height, const std::vector<std::string>& channel_names,
+                          std::vector<float> pixels, const ReadOptions& options = {});
+
 // A loose pass file or a plain image read as one pass of the given role.
 Pass read_pass_file(const std::string& path, Role role);
 

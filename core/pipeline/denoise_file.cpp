@@ -20,12 +20,24 @@ std::pair<std::string, std::string> parse_key_value(const std::string& text, con
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
 
+std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
+                                              const std::vector<std::pair<std::string, std::string>>& params) {
+  std::unique_ptr<Filter> f = make_filter(filter);
+  for (const auto& kv : params) f->set_text(kv.first, kv.second);
+  f->commit();
+  return f;
+}
+
+std::string parameters_text(const Filter& filter) {
+  std::string params;
+  for (const auto& kv : filter.params().values())
+    params += (params.empty() ? "" : " ") + kv.first + "=" + param_value_text(kv.second);
+  return params;
+}
+
 DenoiseSession::DenoiseSession(const std::string& filter,
                                const std::vector<std::pair<std::string, std::string>>& params)
-    : filter_(make_filter(filter)) {
-  for (const auto& kv : params) filter_->set_text(kv.first, kv.second);
-  filter_->commit();
-}
+    : filter_(make_committed_filter(filter, params)) {}
 
 StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
                                const WriteOptions& write, const ExecOptions& exec) {
@@ -42,10 +54,7 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     t0 = std::chrono::steady_clock::now();
     WriteOptions w = write;
     w.attributes.emplace_back("mcrecon:filter", filter_->info().name);
-    std::string params;
-    for (const auto& kv : filter_->params().values())
-      params += (params.empty() ? "" : " ") + kv.first + "=" + param_value_text(kv.second);
-    w.attributes.emplace_back("mcrecon:parameters", params);
+    w.attributes.emplace_back("mcrecon:parameters", parameters_text(*filter_));
     write_result(output, result, frame, w);
     t.write_ms = ms_since(t0);
   }

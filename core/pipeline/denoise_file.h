@@ -35,6 +35,15 @@ class DenoiseSession {
   std::unique_ptr<Filter> filter_;
 };
 
+// The filter made, every key=value set (from its table) and committed: what a
+// session starts with. For front ends that keep filters themselves (the OIIO plugin).
+std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
+                                              const std::vector<std::pair<std::string, std::string>>& params);
+
+// "radius=3 demodulate=false ...": every parameter value of the filter, as the
+// "mcrecon:parameters" header attribute of an output.
+std::string parameters_text(const Filter& filter);
+
 // "key=value" -> pair; throws InvalidArgument.
 std::pair<std::string, std::string> parse_key_value(const std::string& text, const std::string& option);
 

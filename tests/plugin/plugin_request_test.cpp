@@ -1,0 +1,73 @@
+// Names and settings of the OIIO plugin (plugin/request.h): no OpenImageIO involved.
+#include <gtest/gtest.h>
+
+#include "request.h"
+#include "util/error.h"
+
+namespace mcr::plugin {
+namespace {
+
+Errc code_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.code();
+  }
+  ADD_FAILURE() << "no mcr::Error thrown";
+  return Errc::Internal;
+}
+
+TEST(PluginRequest, OnlyMcreconNamesAreOurs) {
+  EXPECT_TRUE(is_plugin_name("render.exr.mcrecon"));
+  EXPECT_TRUE(is_plugin_name("dir/render.exr.MCRECON?filter=box"));
+  EXPECT_FALSE(is_plugin_name("render.exr"));
+  EXPECT_FALSE(is_plugin_name(".mcrecon"));
+  EXPECT_FALSE(is_plugin_name("render.exr?x=.mcrecon"));
+  EXPECT_FALSE(is_plugin_name("render.mcrecon.exr"));
+}
+
+TEST(PluginRequest, SplitsTheQuery) {
+  auto [source, kv] = split_name("d/r.exr.mcrecon?filter=box&radius=3&normal=ViewLayer.Normal");
+  EXPECT_EQ(source, "d/r.exr");
+  ASSERT_EQ(kv.size(), 3u);
+  EXPECT_EQ(kv[1], (std::pair<std::string, std::string>("radius", "3")));
+  EXPECT_EQ(kv[2].second, "ViewLayer.Normal");
+  EXPECT_EQ(split_name("r.exr.mcrecon?a=b=c").second[0].second, "b=c");
+  EXPECT_EQ(code_of([] { split_name("r.exr.mcrecon?filter=box&radius"); }), Errc::InvalidArgument);
+  EXPECT_EQ(code_of([] { split_name("r.exr.mcrecon?filter=box&&a=1"); }), Errc::InvalidArgument);
+}
+
+TEST(PluginRequest, SortsKeysIntoFilterLayerPassesAndParameters) {
+  Request r = make_request("r.exr", {{"filter", "box"}, {"radius", "3"}, {"layer", "VL"}, {"normal", "n.exr"},
+                                     {"color", "VL.Noisy"}},
+                           false);
+  EXPECT_EQ(r.filter, "box");
+  EXPECT_EQ(r.read.layer, "VL");
+  ASSERT_EQ(r.read.overrides.size(), 2u);
+  EXPECT_EQ(r.read.overrides[0].role, Role::Normal);
+  EXPECT_EQ(r.read.overrides[1].role, Role::Colour);
+  ASSERT_EQ(r.params.size(), 1u);
+  EXPECT_EQ(r.params[0].first, "radius");
+  EXPECT_EQ(code_of([] { make_request("r.exr", {{"radius", "3"}}, false); }), Errc::InvalidArgument);
+  EXPECT_EQ(code_of([] { make_request("r.exr", {{"filter", "box"}, {"normal", ""}}, false); }), Errc::InvalidArgument);
+  // keep_passes is an output setting; on input it is a (unknown) filter parameter.
+  EXPECT_TRUE(make_request("o.exr", {{"filter", "box"}, {"keep_passes", "1"}}, true).keep_passes);
+  EXPECT_EQ(make_request("o.exr", {{"filter", "box"}, {"keep_passes", "1"}}, false).params.size(), 1u);
+}
+
+TEST(PluginRequest, StripsOiiotoolTempNames) {
+  EXPECT_EQ(strip_oiiotool_temp("/tmp/pt/o_0001.963d536f.temp.exr"), "/tmp/pt/o_0001.exr");
+  EXPECT_EQ(strip_oiiotool_temp("o.ABCDEF01.temp"), "o");
+  EXPECT_EQ(strip_oiiotool_temp("/tmp/pt/o_0001.exr"), "/tmp/pt/o_0001.exr");
+  EXPECT_EQ(strip_oiiotool_temp("x.temp.exr"), "x.temp.exr");
+  EXPECT_EQ(strip_oiiotool_temp("a.1234567g.temp.exr"), "a.1234567g.temp.exr");
+}
+
+TEST(PluginRequest, FloatTextRoundTrips) {
+  EXPECT_EQ(float_text(0.1f), "0.1");
+  EXPECT_EQ(float_text(3.0f), "3");
+  EXPECT_EQ(std::strtof(float_text(1.0f / 3.0f).c_str(), nullptr), 1.0f / 3.0f);
+}
+
+}  // namespace
+}  // namespace mcr::plugin
