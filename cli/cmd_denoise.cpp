@@ -1,3 +1,4 @@
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -8,6 +9,7 @@
 #include "io/sequence.h"
 #include "pipeline/denoise_file.h"
 #include "progress.h"
+#include "temporal/accumulation.h"
 #include "util/error.h"
 
 namespace mcr::cli {
@@ -18,6 +20,7 @@ struct DenoiseArgs {
   std::string input, output, filter, layer, frames, region, compression = "zip";
   std::vector<std::string> sets, passes;
   bool keep_passes = false, timings = false, verbose = false, resume = false;
+  bool accumulate = false;  // BMFR phase I before the filter
   int threads = 0;
 };
 
@@ -94,7 +97,38 @@ int run_denoise(const DenoiseArgs& a) {
   for (const auto& j : jobs) outputs.push_back(j.second);
   check_output_paths(outputs, inputs);
 
-  const bool temporal = session.filter().info().temporal;
+  const bool temporal = session.filter().info().temporal || a.accumulate;
+  // --accumulate: BMFR phase I (reprojected cumulative/exponential average of the noisy
+  // colour, own history across this run's frames) before the filter, which then sees a
+  // frame whose colour pass holds the accumulated RGB (alpha kept).
+  TemporalAccumulator accumulator;
+  auto run_accumulated = [&](const std::string& in, const std::string& out) {
+    using clock = std::chrono::steady_clock;
+    auto ms = [](clock::time_point t0) { return std::chrono::duration<double, std::milli>(clock::now() - t0).count(); };
+    StageTimes t;
+    auto t0 = clock::now();
+    Frame frame = read_frame(in, ro);
+    t.read_ms = ms(t0);
+    t0 = clock::now();
+    Pass colour = frame.get(Role::Colour);
+    const Image acc = accumulator.accumulate(frame, colour.image.channels() == 3 ? colour.image : colour.image.channel_range(0, 3), eo.nthreads);
+    for (std::size_t i = 0; i < acc.pixel_count(); ++i)
+      for (int c = 0; c < 3; ++c) colour.image.data()[i * std::size_t(colour.image.channels()) + std::size_t(c)] = acc.data()[i * 3 + std::size_t(c)];
+    frame.put(std::move(colour));
+    const Image result = session.filter().execute(frame, eo);
+    t.filter_ms = ms(t0);
+    if (!out.empty()) {
+      t0 = clock::now();
+      WriteOptions w = wo;
+      w.attributes.emplace_back("mcrecon:filter", session.filter().info().name);
+      std::string params = "accumulate=true";
+      for (const auto& kv : session.filter().params().values()) params += " " + kv.first + "=" + param_value_text(kv.second);
+      w.attributes.emplace_back("mcrecon:parameters", params);
+      write_result(out, result, frame, w);
+      t.write_ms = ms(t0);
+    }
+    return t;
+  };
   Progress progress("denoise " + a.filter, int(jobs.size()));
   StageTimes sum;
   int written = 0, skipped = 0;
@@ -108,7 +142,8 @@ int run_denoise(const DenoiseArgs& a) {
       continue;
     }
     // Temporal filters replay finished frames without writing, to warm up history.
-    const StageTimes t = session.run(in, done ? std::string() : out, ro, wo, eo);
+    const StageTimes t = a.accumulate ? run_accumulated(in, done ? std::string() : out)
+                                      : session.run(in, done ? std::string() : out, ro, wo, eo);
     sum.read_ms += t.read_ms;
     sum.filter_ms += t.filter_ms;
     sum.write_ms += t.write_ms;
@@ -141,6 +176,8 @@ Run add_denoise(CLI::App& app) {
   app.add_option("--compression", a->compression, "EXR compression of the output (zip, piz, none, ...)");
   app.add_flag("--keep-passes", a->keep_passes, "carry the input's other channels into the output");
   app.add_flag("--resume", a->resume, "skip frames whose output exists (temporal filters replay them without writing)");
+  app.add_flag("--accumulate", a->accumulate,
+               "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");
   app.add_flag("--timings", a->timings, "print read / filter / write times per frame");
   app.add_flag("-v,--verbose", a->verbose, "timings plus the filter's notes");
   return [a] { return run_denoise(*a); };

@@ -1,6 +1,7 @@
 #include "filters/registry.h"
 
 #include "filters/box.h"
+#include "filters/bmfr.h"
 #include "filters/guided.h"
 #include "filters/pwaf.h"
 #include "util/error.h"
@@ -22,6 +23,7 @@ Entry entry() {
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> list = {
       entry<BoxFilter>(),
+      entry<BmfrFilter>(),
       entry<GuidedFilter>(),
       entry<PwafFilter>(),
   };

@@ -1,0 +1,65 @@
+#pragma once
+// Temporal accumulation (BMFR phase I and III, Koskela et al. 2019, 4.1 and 4.3):
+// the previous accumulated value is reprojected (bilinear, discarded taps left out,
+// normalised by the kept weights only), and blended with the new value by a
+// cumulative moving average (weight 1/n for the n-th sample, n = reprojected sample
+// count rounded to the nearest integer, plus one) until that weight would fall below
+// alpha, then by an exponential moving average of weight alpha.
+//
+// Non-finite input: a pixel whose new value has a NaN/Inf channel keeps its history
+// (count unchanged); with no history it is marked invalid (count 0, value 0), and
+// invalid history taps are never read.
+#include <vector>
+
+#include "image/pass.h"
+#include "temporal/reprojection.h"
+
+namespace mcr {
+
+// One accumulated quantity (any channel count <= 8) with its per-pixel sample count.
+class AccumulationBuffer {
+ public:
+  // Blends `current` with the history reprojected by `r` (same size) and keeps the
+  // result (and the counts) as the new history; returns it (valid until the next call).
+  const Image& accumulate(const Reprojection& r, const Image& current, double alpha, int nthreads);
+  void reset();
+  const Image& value() const { return value_; }
+  const std::vector<float>& count() const { return count_; }  // 0 = invalid pixel
+
+ private:
+  Image value_;
+  std::vector<float> count_;
+};
+
+struct AccumulationParams {
+  double alpha = 0.2;  // BMFR alpha1
+  ReprojectionParams reprojection;
+};
+
+// Phase I on its own: geometry history + one colour buffer. Needs world position and
+// world normal (Prefer::Geometry); uses the motion pass when present (zero motion
+// otherwise: a moving camera then relies on the discard tests alone).
+class TemporalAccumulator {
+ public:
+  explicit TemporalAccumulator(AccumulationParams p = {}) : params_(p) {}
+  void set_params(const AccumulationParams& p) { params_ = p; }
+  const AccumulationParams& params() const { return params_; }
+
+  // Accumulates `colour` (RGB) of `frame`; throws MissingPass without position/normal.
+  // The result stays valid until the next call.
+  const Image& accumulate(const Frame& frame, const Image& colour, int nthreads = 0);
+  const Image& accumulate(const Image& colour, const Image& position, const Image& normal, const Image* motion,
+                          int nthreads = 0);
+
+  const Reprojection& last_reprojection() const { return reprojection_; }
+  const std::vector<float>& sample_count() const { return buffer_.count(); }
+  void reset();
+
+ private:
+  AccumulationParams params_;
+  GeometryHistory geometry_;
+  AccumulationBuffer buffer_;
+  Reprojection reprojection_;
+};
+
+}  // namespace mcr

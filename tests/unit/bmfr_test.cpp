@@ -1,0 +1,252 @@
+// BMFR: exact fits of colours that are linear in the features, stress inputs, thread
+// independence, camera cuts and the parameter rules.
+#include "filters/bmfr.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "filters/registry.h"
+#include "util/error.h"
+
+namespace mcr {
+namespace {
+
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+Pass make_pass(Role role, const std::string& name, Image im, Space space = Space::None) {
+  Pass p;
+  p.role = role;
+  p.name = name;
+  p.space = space;
+  p.image = std::move(im);
+  return p;
+}
+
+// A curved surface seen by a static camera: positions, normals, and a colour that is
+// exactly  0.4 + 0.2 n_x + 0.3 w_x - 0.1 w_y + 0.25 w_z^2  (per channel scaled).
+struct Scene {
+  Image colour, position, normal, albedo, motion;
+};
+
+Scene linear_scene(int w, int h, float shift = 0.0f) {
+  Scene s{Image(w, h, 3), Image(w, h, 3), Image(w, h, 3), Image(w, h, 3, 1.0f), Image(w, h, 4)};
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float wx = 0.05f * (float(x) + shift), wy = 0.05f * float(y), wz = std::sin(0.13f * float(x) + 0.07f * float(y));
+      float* p = s.position.pixel(x, y);
+      p[0] = wx; p[1] = wy; p[2] = wz;
+      float* n = s.normal.pixel(x, y);
+      const float nx = std::cos(0.09f * float(x)) * 0.6f, nz = std::sqrt(1.0f - nx * nx);
+      n[0] = nx; n[1] = 0.0f; n[2] = nz;
+      const double v = 0.4 + 0.2 * nx + 0.3 * wx - 0.1 * wy + 0.25 * double(wz) * wz;
+      for (int c = 0; c < 3; ++c) s.colour.pixel(x, y)[c] = float(v * (1.0 + 0.2 * c));
+    }
+  return s;
+}
+
+Frame frame_of(const Scene& s, bool albedo = true, bool motion = true) {
+  Frame f;
+  f.width = s.colour.width();
+  f.height = s.colour.height();
+  f.path = "synthetic.exr";
+  f.passes.push_back(make_pass(Role::Colour, "Combined", s.colour));
+  f.passes.push_back(make_pass(Role::Position, "Position", s.position, Space::World));
+  f.passes.push_back(make_pass(Role::Normal, "Normal", s.normal, Space::World));
+  if (albedo) f.passes.push_back(make_pass(Role::Albedo, "Denoising Albedo", s.albedo));
+  if (motion) f.passes.push_back(make_pass(Role::Motion, "Vector", s.motion));
+  return f;
+}
+
+std::unique_ptr<Filter> make_bmfr(std::initializer_list<std::pair<const char*, ParamValue>> params = {}) {
+  auto f = make_filter("bmfr");
+  for (const auto& kv : params) f->set(kv.first, kv.second);
+  f->commit();
+  return f;
+}
+
+double max_rel_error(const Image& got, const Image& want) {
+  double e = 0;
+  for (std::size_t i = 0; i < want.storage().size(); ++i)
+    e = std::max(e, std::fabs(double(got.storage()[i]) - want.storage()[i]) / (std::fabs(want.storage()[i]) + 0.1));
+  return e;
+}
+
+TEST(Bmfr, RegisteredWithItsTable) {
+  const FilterInfo& info = filter_info("bmfr");
+  EXPECT_TRUE(info.temporal);
+  EXPECT_EQ(info.sweep_param, "block_size");
+  EXPECT_EQ(info.sweep_values, (std::vector<double>{16, 32, 64}));
+  EXPECT_FALSE(info.nonfinite_policy.empty());
+}
+
+TEST(Bmfr, ReproducesColourLinearInTheFeatures) {
+  // Partial edge blocks (70 x 45 is not a multiple of any block size) and every offset.
+  const Scene s = linear_scene(70, 45);
+  for (const char* set : {"default", "with_albedo", "with_depth"}) {
+    if (std::string(set) == "with_depth") continue;  // no depth pass here; see the error test
+    for (double eps : {0.0, 0.01}) {
+      auto f = make_bmfr({{"features", std::string(set)}, {"epsilon", eps}, {"block_size", std::int64_t(16)}});
+      Image out;
+      for (int k = 0; k < 6; ++k) out = f->execute(frame_of(s));
+      EXPECT_LT(max_rel_error(out, s.colour), eps == 0 ? 1e-4 : 2e-2) << set << " eps " << eps;
+      EXPECT_EQ(f->nonfinite_repaired(), 0u);
+    }
+  }
+  // First order cannot represent w_z^2 exactly: a worse but still close fit.
+  auto f = make_bmfr({{"features", std::string("first_order")}, {"epsilon", 0.0}});
+  const Image out = f->execute(frame_of(s));
+  EXPECT_LT(max_rel_error(out, s.colour), 0.5);
+}
+
+TEST(Bmfr, DemodulatesByAlbedo) {
+  Scene s = linear_scene(40, 40);
+  // Textured albedo (checker): colour = albedo * illumination; the fit sees the
+  // illumination, so the texture survives exactly.
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 40; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float a = ((x / 3 + y / 3) % 2) ? 0.9f : 0.2f;
+        s.albedo.pixel(x, y)[c] = a;
+        s.colour.pixel(x, y)[c] *= a;
+      }
+  auto f = make_bmfr({{"epsilon", 0.0}});
+  const Image out = f->execute(frame_of(s));
+  EXPECT_LT(max_rel_error(out, s.colour), 1e-4);
+  // Without demodulation the checker is not in the feature span.
+  auto g = make_bmfr({{"epsilon", 0.0}, {"albedo_demodulation", false}});
+  EXPECT_GT(max_rel_error(g->execute(frame_of(s)), s.colour), 1e-2);
+}
+
+TEST(Bmfr, CommonDemodulateDividesOnlyOnce) {
+  // demodulate=true (base class, around the whole pipeline) replaces albedo_demodulation:
+  // dividing twice would leave albedo^-1 in the fit and break the exact reproduction.
+  Scene s = linear_scene(40, 40);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 40; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float a = ((x / 3 + y / 3) % 2) ? 0.9f : 0.2f;
+        s.albedo.pixel(x, y)[c] = a;
+        s.colour.pixel(x, y)[c] *= a;
+      }
+  auto f = make_bmfr({{"epsilon", 0.0}, {"demodulate", true}});
+  EXPECT_LT(max_rel_error(f->execute(frame_of(s)), s.colour), 1e-4);
+}
+
+TEST(Bmfr, MissingFeaturePassIsAnError) {
+  auto f = make_bmfr({{"features", std::string("with_depth")}});
+  try {
+    f->execute(frame_of(linear_scene(8, 8)));
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), Errc::MissingPass);
+  }
+}
+
+void expect_finite(const Image& im, const std::string& what) {
+  for (float v : im.storage()) ASSERT_TRUE(std::isfinite(v)) << what;
+}
+
+TEST(Bmfr, StressInputsStayFinite) {
+  const std::vector<std::pair<int, int>> sizes = {{1, 1}, {1, 17}, {23, 1}, {2, 2}, {33, 31}};
+  for (auto [w, h] : sizes) {
+    for (int pass = 0; pass < 7; ++pass) {
+      for (double eps : {0.0, 1e-4, 1.0}) {
+        auto f = make_bmfr({{"epsilon", eps}, {"block_size", std::int64_t(8)}});
+        for (int k = 0; k < 4; ++k) {
+          Scene s = linear_scene(w, h, float(k));
+          // Poison a few pixels in one pass (and everything in the last frame for pass 5).
+          auto poison = [&](Image& im, float v) {
+            for (std::size_t i = 0; i < im.storage().size(); i += 7) im.storage()[i] = (i / 7) % 2 ? v : -v;
+          };
+          switch (pass) {
+            case 0: poison(s.colour, kNaN); poison(s.colour, kInf); break;
+            case 1: poison(s.albedo, kNaN); break;
+            case 2: poison(s.normal, kInf); break;
+            case 3: poison(s.position, kNaN); break;
+            case 4: poison(s.motion, kNaN); break;
+            case 5: std::fill(s.albedo.storage().begin(), s.albedo.storage().end(), 0.0f); break;
+            case 6:
+              for (float& v : s.colour.storage()) v *= 1e30f;
+              for (float& v : s.position.storage()) v *= 1e30f;
+              break;
+          }
+          const Image out = f->execute(frame_of(s));
+          const std::string what = std::to_string(w) + "x" + std::to_string(h) + " pass " + std::to_string(pass) +
+                                   " eps " + std::to_string(eps) + " frame " + std::to_string(k);
+          expect_finite(out, what);
+          EXPECT_EQ(f->nonfinite_repaired(), 0u) << what;
+        }
+      }
+    }
+  }
+}
+
+TEST(Bmfr, AllColourNonFiniteGivesZeroNotNaN) {
+  Scene s = linear_scene(20, 20);
+  std::fill(s.colour.storage().begin(), s.colour.storage().end(), kNaN);
+  auto f = make_bmfr();
+  const Image out = f->execute(frame_of(s));
+  for (float v : out.storage()) EXPECT_EQ(v, 0.0f);
+  EXPECT_EQ(f->nonfinite_repaired(), 0u);
+}
+
+TEST(Bmfr, SameResultForOneAndTwoThreads) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  auto f1 = make_bmfr(), f2 = make_bmfr();
+  for (int k = 0; k < 4; ++k) {
+    Scene s = linear_scene(75, 50, float(k));
+    for (int y = 0; y < 50; ++y)
+      for (int x = 0; x < 75; ++x) s.motion.pixel(x, y)[0] = 1.0f;  // camera moving by one pixel
+    for (float& v : s.colour.storage()) v *= 2.0f * u(rng);
+    ExecOptions one, two;
+    one.nthreads = 1;
+    two.nthreads = 2;
+    const Image a = f1->execute(frame_of(s), one), b = f2->execute(frame_of(s), two);
+    ASSERT_EQ(a.storage(), b.storage()) << "frame " << k;
+  }
+}
+
+TEST(Bmfr, DetectsCameraCutAndSizeChange) {
+  auto f = make_bmfr();
+  auto* b = dynamic_cast<BmfrFilter*>(f.get());
+  ASSERT_NE(b, nullptr);
+  Scene s = linear_scene(40, 30);
+  f->execute(frame_of(s));
+  f->execute(frame_of(s));
+  EXPECT_FALSE(b->last_cut());
+  // Another shot: every position elsewhere.
+  Scene t = s;
+  for (float& v : t.position.storage()) v += 50.0f;
+  for (float& v : t.colour.storage()) v = 2.0f;
+  const Image out = f->execute(frame_of(t));
+  EXPECT_TRUE(b->last_cut());
+  // Restarted: the old shot's light does not leak in.
+  for (float v : out.storage()) EXPECT_NEAR(v, 2.0f, 1e-3);
+  f->execute(frame_of(t));
+  EXPECT_FALSE(b->last_cut());
+  // Size change: runs and restarts.
+  const Image small = f->execute(frame_of(linear_scene(17, 9)));
+  EXPECT_EQ(small.width(), 17);
+  expect_finite(small, "size change");
+}
+
+TEST(Bmfr, RoiKeepsTheInputOutside) {
+  const Scene s = linear_scene(30, 20);
+  auto f = make_bmfr();
+  ExecOptions eo;
+  eo.roi = {5, 5, 12, 9};
+  const Image out = f->execute(frame_of(s), eo);
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 30; ++x) {
+      const bool in = x >= 5 && x < 12 && y >= 5 && y < 9;
+      if (!in) EXPECT_EQ(out.at(x, y, 0), s.colour.at(x, y, 0));
+    }
+}
+
+}  // namespace
+}  // namespace mcr
