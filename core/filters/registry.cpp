@@ -1,8 +1,11 @@
 #include "filters/registry.h"
 
-#include "filters/box.h"
+#include "filters/atrous.h"
+#include "filters/bilateral.h"
 #include "filters/bmfr.h"
+#include "filters/box.h"
 #include "filters/guided.h"
+#include "filters/gaussian.h"
 #include "filters/pwaf.h"
 #include "util/error.h"
 
@@ -23,9 +26,12 @@ Entry entry() {
 const std::vector<Entry>& entries() {
   static const std::vector<Entry> list = {
       entry<BoxFilter>(),
-      entry<BmfrFilter>(),
       entry<GuidedFilter>(),
+      entry<GaussianFilter>(),
+      entry<BilateralFilter>(),
+      entry<AtrousFilter>(),
       entry<PwafFilter>(),
+      entry<BmfrFilter>(),
   };
   return list;
 }

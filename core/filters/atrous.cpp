@@ -1,0 +1,145 @@
+#include "filters/atrous.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "filters/feature_weights.h"
+#include "filters/foveation.h"
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+ParamTable atrous_params() {
+  FeatureDefaults d;
+  ParamTable t = {
+      ParamSpec::Int("kernel_size", 5, 3, 9,
+                     "generating kernel size k_g: 3 = [1 2 1]/4, 5 = [1 4 6 4 1]/16 (B3 spline, Dammertz), "
+                     "9 = [1 8 28 56 70 56 28 8 1]/256 (the 5-tap kernel convolved with itself); 3, 5 or 9"),
+      ParamSpec::Int("iterations", 5, 1, 10,
+                     "passes; pass i spaces the taps 2^(i-1) pixels apart (effective size k_g 2^(i-1))"),
+  };
+  for (ParamSpec& s : feature_params(d)) t.push_back(s);
+  t.push_back(ParamSpec::Float("colour_sigma_decay", 0.5, 0.05, 1.0,
+                               "pass i uses colour_sigma * decay^(i-1): 0.5 halves it every pass as in Dammertz et al. "
+                               "(sigma_rt 2^-i), 1 keeps it constant"));
+  t.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
+                               "firefly clamp: > 0 clamps every colour channel to [-clamp, clamp] before filtering; "
+                               "0 = off (the colour weight alone keeps fireflies from spreading)"));
+  return with_common_params(with_foveation(t, feature_sigma_names()));
+}
+
+}  // namespace
+
+std::vector<float> AtrousFilter::generating_kernel(int kg) {
+  switch (kg) {
+    case 3: return {0.25f, 0.5f, 0.25f};
+    case 5: return {1 / 16.f, 4 / 16.f, 6 / 16.f, 4 / 16.f, 1 / 16.f};
+    case 9: return {1 / 256.f, 8 / 256.f, 28 / 256.f, 56 / 256.f, 70 / 256.f, 56 / 256.f, 28 / 256.f, 8 / 256.f, 1 / 256.f};
+  }
+  throw Error(Errc::Internal, "atrous: no generating kernel of size " + std::to_string(kg));
+}
+
+const FilterInfo& AtrousFilter::static_info() {
+  static const FilterInfo info = [] {
+    FilterInfo i;
+    i.name = "atrous";
+    i.summary = "Edge-avoiding A-Trous wavelet filter: iterated cross-bilateral passes with a dilated 3/5/9-tap kernel";
+    i.reference = "Dammertz, Sewtz, Hanika, Lensch 2010 (HPG); Immonen 2017, sections 3.3, 4.1, 5.3, 5.4";
+    i.params = atrous_params();
+    i.required = {Role::Colour};
+    i.optional = {Role::Normal, Role::Position, Role::Albedo, Role::Depth};
+    i.nonfinite_policy =
+        "a neighbour whose colour or any used feature has a non-finite value gets weight 0 in every pass; a pixel "
+        "whose own colour is non-finite skips the colour weight, one whose own feature f is non-finite skips f; a "
+        "pixel whose taps all have weight 0 keeps its colour if finite, else gives 0 and stays unusable as a "
+        "neighbour in the next pass. Feature differences that overflow give weight 0 (never NaN); colour beyond "
+        "[2^-20, 2^100] is scaled by an exact power of two while summing, so sums never overflow and tiny values "
+        "keep their precision";
+    i.sweep_param = "iterations";
+    i.sweep_values = {1, 2, 3, 4, 5, 6};
+    return i;
+  }();
+  return info;
+}
+
+void AtrousFilter::check_params() {
+  const std::int64_t kg = params_.get_int("kernel_size");
+  if (kg != 3 && kg != 5 && kg != 9)
+    throw Error(Errc::ParameterOutOfRange,
+                "parameter 'kernel_size' of filter 'atrous' must be 3, 5 or 9, got " + std::to_string(kg));
+  check_foveation_params(params_, info().name);
+}
+
+void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
+  const int w = frame.width, h = frame.height;
+  const int kg = int(params_.get_int("kernel_size"));
+  const int iterations = int(params_.get_int("iterations"));
+  const double decay = params_.get_float("colour_sigma_decay");
+  const std::vector<float> h1 = generating_kernel(kg);
+  const int half = kg / 2;
+
+  // Pass i reaches half * 2^(i-1); pass i must cover roi grown by what the later passes reach.
+  std::vector<int> grow(std::size_t(iterations) + 1, 0);  // grow[i] = reach of passes i+1..n
+  for (int i = iterations - 1; i >= 0; --i) grow[std::size_t(i)] = std::min(1 << 20, grow[std::size_t(i) + 1] + half * (1 << i));
+  const Roi box = grow_roi(roi, grow[0], w, h);
+
+  const Foveation fov(params_, w, h);
+  planar_colour(colour, box, params_.get_float("clamp"), nthreads, cp_);
+  ColourPlanes& cp = cp_;
+  const PlaneBox& pb = cp.pb;
+  gather_guides(frame, params_, fov, info().name, pb, [this](std::string s) { note(std::move(s)); }, nthreads, guides_);
+  const Guides& guides = guides_;
+
+  // Ping-pong between the colour planes and next_; pixels outside the region a
+  // pass writes are never read by the later passes (their regions shrink).
+  for (auto& p : next_) pb.prepare(p);
+  pb.prepare(next_ok_);
+  pb.prepare(valid_);
+  std::vector<float>& valid = valid_;
+  std::vector<float>* cur = cp.c;
+  std::vector<float>* cur_ok = &cp.ok;
+  std::vector<float>* nxt = next_;
+  std::vector<float>* nxt_ok = &next_ok_;
+
+  CrossPass pass;
+  pass.pb = pb;
+  pass.colour_weight = guides.colour;
+  pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
+  pass.colour_a_const = guides.colour_a_const;
+  for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
+  const int bh = box.height();
+  for (int i = 1; i <= iterations; ++i) {
+    const int step = 1 << (i - 1);
+    const Roi region = grow_roi(roi, grow[std::size_t(i)], w, h);
+    // Neighbours must hold data (colour) and finite features.
+    parallel_rows(0, bh, nthreads, [&](int y) {
+      const std::size_t a = std::size_t(y) * pb.stride, b = a + pb.stride;
+      for (std::size_t k = a; k < b; ++k) valid[k] = (*cur_ok)[k] * guides.ok[k];
+    });
+    for (int c = 0; c < 3; ++c) {
+      pass.colour[c] = cur[c].data();
+      pass.out[c] = nxt[c].data();
+    }
+    pass.colour_ok = cur_ok->data();
+    pass.out_ok = nxt_ok->data();
+    pass.valid = valid.data();
+    // sigma_i = colour_sigma decay^(i-1): a_i = a / decay^(i-1), / scale for the scaled colour.
+    pass.colour_amul = float(std::min(1e30, std::pow(decay, -double(i - 1)) / double(cp.scale)));
+    pass.off.clear();
+    pass.h.clear();
+    for (int k = -half; k <= half; ++k) {
+      pass.off.push_back(k * step);
+      pass.h.push_back(h1[std::size_t(k + half)]);
+    }
+    cross_filter(pass, region, nthreads);
+    std::swap(cur, nxt);
+    std::swap(cur_ok, nxt_ok);
+  }
+  const float* planes[3] = {cur[0].data(), cur[1].data(), cur[2].data()};
+  store_colour(planes, pb, cp.scale, roi, out, nthreads);
+}
+
+}  // namespace mcr

@@ -1,0 +1,140 @@
+#include "filters/bilateral.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "filters/feature_weights.h"
+#include "filters/foveation.h"
+#include "filters/gaussian.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+ParamTable bilateral_params() {
+  ParamTable t = {
+      ParamSpec::Float("spatial_sigma", 2.0, 0.0, 21.0,
+                       "standard deviation of the spatial Gaussian in pixels (0 = no filtering)"),
+      ParamSpec::Int("radius", 0, 0, 64,
+                     "window half width in pixels; 0 = ceil(3 spatial_sigma) at each pixel (follows foveation)"),
+  };
+  for (ParamSpec& s : feature_params()) t.push_back(s);
+  t.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
+                               "firefly clamp: > 0 clamps every colour channel to [-clamp, clamp] before filtering; "
+                               "0 = off (the colour weight alone keeps fireflies from spreading)"));
+  std::vector<std::string> fov = {"spatial_sigma"};
+  for (const std::string& n : feature_sigma_names()) fov.push_back(n);
+  return with_common_params(with_foveation(t, fov));
+}
+
+}  // namespace
+
+const FilterInfo& BilateralFilter::static_info() {
+  static const FilterInfo info = [] {
+    FilterInfo i;
+    i.name = "bilateral";
+    i.summary = "Cross-bilateral filter: spatial Gaussian times colour, normal, position, albedo and depth weights";
+    i.reference = "Immonen 2017, sections 3.4 and 5.3 (Cross-Bilateral); Tomasi & Manduchi 1998; Eisemann & Durand 2004";
+    i.params = bilateral_params();
+    i.required = {Role::Colour};
+    i.optional = {Role::Normal, Role::Position, Role::Albedo, Role::Depth};
+    i.nonfinite_policy =
+        "a neighbour whose colour or any used feature has a non-finite value gets weight 0; a pixel whose own colour "
+        "is non-finite skips the colour weight, and one whose own feature f is non-finite skips f, and is then the "
+        "weighted mean of its usable neighbours; a window with no usable sample keeps the pixel's colour if finite, "
+        "else gives 0. Feature differences that overflow give weight 0 (never NaN); colour beyond [2^-20, 2^100] is "
+        "scaled by an exact power of two while summing, so sums never overflow and tiny values keep their precision";
+    i.sweep_param = "spatial_sigma";
+    i.sweep_values = {1, 2, 3, 4};
+    return i;
+  }();
+  return info;
+}
+
+void BilateralFilter::check_params() { check_foveation_params(params_, info().name); }
+
+void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
+  const int w = frame.width, h = frame.height;
+  const Foveation fov(params_, w, h);
+  const int fixed = int(params_.get_int("radius"));
+  auto radius_at = [&](double sigma) { return sigma > 0 ? (fixed > 0 ? fixed : GaussianFilter::radius_for(sigma)) : 0; };
+
+  const FoveatedValue spatial = fov.param("spatial_sigma");
+  int rmax = 0, rmin = 1 << 30;
+  if (spatial.varies) {
+    std::vector<int> row_min(std::size_t(roi.height())), row_max(std::size_t(roi.height()));
+    parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
+      int lo = 1 << 30, hi = 0;
+      for (int x = roi.x0; x < roi.x1; ++x) {
+        const int r = radius_at(spatial.at(fov.blend_at(x, y)));
+        lo = std::min(lo, r);
+        hi = std::max(hi, r);
+      }
+      row_min[std::size_t(y - roi.y0)] = lo;
+      row_max[std::size_t(y - roi.y0)] = hi;
+    });
+    rmin = *std::min_element(row_min.begin(), row_min.end());
+    rmax = *std::max_element(row_max.begin(), row_max.end());
+  } else {
+    rmax = rmin = radius_at(spatial.inner);
+  }
+
+  const Roi box = grow_roi(roi, rmax, w, h);
+  planar_colour(colour, box, params_.get_float("clamp"), nthreads, cp_);
+  const ColourPlanes& cp = cp_;
+  const PlaneBox& pb = cp.pb;
+  gather_guides(frame, params_, fov, info().name, pb, [this](std::string s) { note(std::move(s)); }, nthreads, guides_);
+  const Guides& guides = guides_;
+  const std::size_t n = pb.size();
+  std::vector<float>& valid = valid_;
+  valid.resize(n);
+  parallel_rows(0, box.height(), nthreads, [&](int y) {
+    for (std::size_t i = std::size_t(y) * pb.stride, e = i + std::size_t(pb.stride); i < e; ++i)
+      valid[i] = cp.ok[i] * guides.ok[i];  // pads: 0 * 0
+  });
+
+  // Spatial coefficient 1/(2 sigma^2) and window radius, per pixel where foveation varies them.
+  auto coef = [](double sg) { return sg > 0 ? float(std::min(1e30, 1.0 / (2.0 * sg * sg))) : 0.0f; };
+  std::vector<float>& s = s_;
+  std::vector<float>& rad = rad_;
+  s.clear();
+  rad.clear();
+  if (spatial.varies) {
+    pb.prepare(s);
+    if (rmin != rmax) pb.prepare(rad);
+    parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+      for (int x = box.x0; x < box.x1; ++x) {
+        const double sg = spatial.at(fov.blend_at(x, y));
+        s[pb.index(x, y)] = coef(sg);
+        if (!rad.empty()) rad[pb.index(x, y)] = float(radius_at(sg));
+      }
+    });
+  }
+
+  std::vector<float>* res = res_;
+  for (int c = 0; c < 3; ++c) pb.prepare(res[c]);
+  CrossPass pass;
+  pass.pb = pb;
+  for (int c = 0; c < 3; ++c) pass.colour[c] = cp.c[c].data();
+  pass.colour_ok = cp.ok.data();
+  pass.valid = valid.data();
+  pass.colour_weight = guides.colour;
+  pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
+  pass.colour_a_const = guides.colour_a_const;
+  pass.colour_amul = 1.0f / cp.scale;  // the colour planes are scaled
+  for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
+  pass.s = s.empty() ? nullptr : s.data();
+  pass.s_const = coef(spatial.inner);
+  pass.radius = rad.empty() ? nullptr : rad.data();
+  for (int k = -rmax; k <= rmax; ++k) {
+    pass.off.push_back(k);
+    pass.h.push_back(1.0f);
+  }
+  for (int c = 0; c < 3; ++c) pass.out[c] = res[c].data();
+  cross_filter(pass, roi, nthreads);
+  const float* planes[3] = {res[0].data(), res[1].data(), res[2].data()};
+  store_colour(planes, pb, cp.scale, roi, out, nthreads);
+}
+
+}  // namespace mcr

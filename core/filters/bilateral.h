@@ -1,0 +1,28 @@
+#pragma once
+#include "filters/feature_weights.h"
+#include "filters/filter.h"
+
+namespace mcr {
+
+// Cross-bilateral filter (Immonen 2017, 3.4 and 5.3): for every pixel p
+//   out(p) = sum_q w(p,q) c(q) / sum_q w(p,q),
+//   w(p,q) = exp(-|q-p|^2 / (2 spatial_sigma^2)) * prod_f exp(-|f(p)-f(q)|^2 / (2 f_sigma^2))
+// over the square window |q-p| <= radius (clipped and renormalised at the borders),
+// f in {colour, normal, position, albedo, depth}, each switched by use_<f>.
+class BilateralFilter : public Filter {
+ public:
+  BilateralFilter() : Filter(static_info()) {}
+  static const FilterInfo& static_info();
+
+ protected:
+  void check_params() override;
+  void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
+
+ private:
+  // Scratch planes kept between execute() calls (no page faults frame after frame).
+  ColourPlanes cp_;
+  Guides guides_;
+  std::vector<float> valid_, s_, rad_, res_[3];
+};
+
+}  // namespace mcr

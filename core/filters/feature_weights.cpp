@@ -1,0 +1,673 @@
+#include "filters/feature_weights.h"
+
+// The kernel's W-lane vectors only live inside always-inlined code of functions
+// compiled for the matching instruction set; GCC warns that returning them would
+// change the ABI elsewhere, which never happens.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+#include <algorithm>
+#include <array>
+#include <atomic>
+#include <cfloat>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <utility>
+
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+constexpr Feature kFeatures[kFeatureCount] = {Feature::Colour, Feature::Normal, Feature::Position, Feature::Albedo,
+                                              Feature::Depth};
+
+Role feature_role(Feature f) {
+  switch (f) {
+    case Feature::Colour: return Role::Colour;
+    case Feature::Normal: return Role::Normal;
+    case Feature::Position: return Role::Position;
+    case Feature::Albedo: return Role::Albedo;
+    case Feature::Depth: return Role::Depth;
+  }
+  return Role::Colour;
+}
+
+// Largest k we let into the kernel: k * 0 must stay 0 (never inf * 0 = NaN), and
+// k = 1e30 already zeroes any weight whose feature difference is above ~1e-14.
+constexpr double kMaxK = 1e30;
+
+float k_of_sigma(double sigma) { return float(std::min(kMaxK, 1.0 / (2.0 * sigma * sigma))); }
+
+}  // namespace
+
+const char* feature_name(Feature f) {
+  switch (f) {
+    case Feature::Colour: return "colour";
+    case Feature::Normal: return "normal";
+    case Feature::Position: return "position";
+    case Feature::Albedo: return "albedo";
+    case Feature::Depth: return "depth";
+  }
+  return "?";
+}
+
+ParamTable feature_params(const FeatureDefaults& d) {
+  static const char* what[kFeatureCount] = {
+      "colour (range) weight, on the colour as filtered (after demodulation; it always exists, so auto = on)",
+      "normal weight (Blender's camera-space Denoising Normal, else Normal)",
+      "world-position weight",
+      "albedo (texture) weight",
+      "depth weight (first channel of the depth pass; off by default: position carries it)"};
+  static const char* unit[kFeatureCount] = {"radiance units", "unit-vector difference", "scene units", "reflectance",
+                                            "scene units"};
+  ParamTable t;
+  for (int i = 0; i < kFeatureCount; ++i) {
+    const std::string n = feature_name(kFeatures[i]);
+    t.push_back(ParamSpec::Enum("use_" + n, d.use[i], {"auto", "on", "off"},
+                                std::string(what[i]) + ": auto = used when the pass exists (dropped with a note otherwise), "
+                                                       "on = required (missing pass is an error), off = not used"));
+    t.push_back(ParamSpec::Float(n + "_sigma", d.sigma[i], 1e-6, 1e6,
+                                 "sigma of the " + n + " weight exp(-|d|^2/(2 sigma^2)), in " + unit[i] +
+                                     "; smaller = stronger edge stopping"));
+  }
+  return t;
+}
+
+std::vector<std::string> feature_sigma_names() {
+  std::vector<std::string> names;
+  for (Feature f : kFeatures) names.push_back(std::string(feature_name(f)) + "_sigma");
+  return names;
+}
+
+Roi grow_roi(const Roi& roi, int reach, int w, int h) {
+  return Roi{roi.x0 - reach, roi.y0 - reach, roi.x1 + reach, roi.y1 + reach}.clipped(w, h);
+}
+
+std::vector<float> PlaneBox::plane(float fill) const {
+  std::vector<float> p;
+  prepare(p, fill);
+  return p;
+}
+
+void PlaneBox::prepare(std::vector<float>& v) const {
+  if (v.size() != size()) {
+    v.assign(size(), 0.0f);
+    return;
+  }
+  const int w = box.width();
+  for (int y = box.y0; y < box.y1; ++y) {
+    float* row = v.data() + index(box.x0, y);
+    std::fill(row - kPlanePad, row, 0.0f);
+    std::fill(row + w, row + w + kPlanePad, 0.0f);
+  }
+}
+
+void PlaneBox::prepare(std::vector<float>& v, float fill) const {
+  prepare(v);
+  for (int y = box.y0; y < box.y1; ++y) std::fill_n(v.begin() + std::ptrdiff_t(index(box.x0, y)), box.width(), fill);
+}
+
+namespace {
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
+#else
+#define MCR_CLONES
+#endif
+
+// One row of n pixels of a 3-channel image into three planes, branch-free so that
+// it vectorises: a pixel with a non-finite channel (|v| <= FLT_MAX fails for NaN
+// and inf) becomes 0 with ok 0; finite channels are clamped to [-lim, lim].
+// Returns the largest |value| written, as its bit pattern (an unsigned max
+// vectorises where a float max would need -ffast-math).
+MCR_CLONES std::uint32_t split_rgb3(const float* __restrict v, int n, float lim, float* __restrict c0,
+                                    float* __restrict c1, float* __restrict c2, float* __restrict ok) {
+  std::uint32_t mb = 0;
+  for (int x = 0; x < n; ++x) {
+    const float r = v[3 * x], g = v[3 * x + 1], b = v[3 * x + 2];
+    const bool f = std::fabs(r) <= FLT_MAX && std::fabs(g) <= FLT_MAX && std::fabs(b) <= FLT_MAX;
+    const float a0 = f ? std::min(std::max(r, -lim), lim) : 0.0f;
+    const float a1 = f ? std::min(std::max(g, -lim), lim) : 0.0f;
+    const float a2 = f ? std::min(std::max(b, -lim), lim) : 0.0f;
+    c0[x] = a0;
+    c1[x] = a1;
+    c2[x] = a2;
+    ok[x] = f ? 1.0f : 0.0f;
+    std::uint32_t b0, b1, b2;
+    std::memcpy(&b0, &a0, 4);
+    std::memcpy(&b1, &a1, 4);
+    std::memcpy(&b2, &a2, 4);
+    mb = std::max(mb, std::max(b0 & 0x7fffffffu, std::max(b1 & 0x7fffffffu, b2 & 0x7fffffffu)));
+  }
+  return mb;
+}
+
+// The same for any channel count (the first `planes` channels, the last one
+// repeated when the image has fewer), not vectorised.
+std::uint32_t split_any(const float* v, int ch, int n, int planes, float lim, float* const* c, float* ok) {
+  std::uint32_t mb = 0;
+  for (int x = 0; x < n; ++x, v += ch) {
+    bool f = true;
+    for (int k = 0; k < planes; ++k) f = f && std::isfinite(v[std::min(k, ch - 1)]);
+    for (int k = 0; k < planes; ++k) {
+      const float a = f ? std::min(std::max(v[std::min(k, ch - 1)], -lim), lim) : 0.0f;
+      c[k][x] = a;
+      std::uint32_t b;
+      std::memcpy(&b, &a, 4);
+      mb = std::max(mb, b & 0x7fffffffu);
+    }
+    ok[x] = f ? 1.0f : 0.0f;
+  }
+  return mb;
+}
+
+MCR_CLONES void scale_row(float* __restrict v, int n, float s) {
+  for (int x = 0; x < n; ++x) v[x] *= s;
+}
+
+}  // namespace
+
+void planar_colour(const Image& colour, const Roi& box, double clamp, int nthreads, ColourPlanes& p) {
+  p.pb = PlaneBox(box);
+  p.scale = 1.0f;
+  for (auto& c : p.c) p.pb.prepare(c);
+  p.pb.prepare(p.ok);
+  const float lim = clamp > 0 ? float(std::min(clamp, double(FLT_MAX))) : FLT_MAX;
+  std::vector<std::uint32_t> row_max(std::size_t(std::max(0, box.height())), 0);
+  parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+    const std::size_t i0 = p.pb.index(box.x0, y);
+    float* c[3] = {p.c[0].data() + i0, p.c[1].data() + i0, p.c[2].data() + i0};
+    const float* v = colour.pixel(box.x0, y);
+    row_max[std::size_t(y - box.y0)] =
+        colour.channels() == 3 ? split_rgb3(v, box.width(), lim, c[0], c[1], c[2], p.ok.data() + i0)
+                               : split_any(v, colour.channels(), box.width(), 3, lim, c, p.ok.data() + i0);
+  });
+  std::uint32_t mb = row_max.empty() ? 0 : *std::max_element(row_max.begin(), row_max.end());
+  float m;
+  std::memcpy(&m, &mb, 4);
+  // Scale only out of [2^-20, 2^100]: huge values down so no sum overflows, tiny
+  // ones up (at most 2^64) so their products stay clear of the denormals.
+  if (m > 0.0f && (m > std::ldexp(1.0f, 100) || m < std::ldexp(1.0f, -20))) {
+    int e = 0;
+    std::frexp(m, &e);  // 2^(e-1) <= m < 2^e
+    p.scale = std::ldexp(1.0f, std::min(64, 100 - e));
+    parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+      for (auto& c : p.c) scale_row(c.data() + p.pb.index(box.x0, y), box.width(), p.scale);
+    });
+  }
+}
+
+namespace {
+
+MCR_CLONES void merge_rgb3(const float* __restrict c0, const float* __restrict c1, const float* __restrict c2, int n,
+                           float inv, float* __restrict o) {
+  for (int x = 0; x < n; ++x) {
+    o[3 * x + 0] = std::min(std::max(c0[x] * inv, -FLT_MAX), FLT_MAX);
+    o[3 * x + 1] = std::min(std::max(c1[x] * inv, -FLT_MAX), FLT_MAX);
+    o[3 * x + 2] = std::min(std::max(c2[x] * inv, -FLT_MAX), FLT_MAX);
+  }
+}
+
+}  // namespace
+
+void store_colour(const float* const planes[3], const PlaneBox& pb, float scale, const Roi& roi, Image& out,
+                  int nthreads) {
+  const float inv = 1.0f / scale;  // a power of two: exact, and the clamp catches any overflow
+  parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
+    const std::size_t i0 = pb.index(roi.x0, y);
+    merge_rgb3(planes[0] + i0, planes[1] + i0, planes[2] + i0, roi.width(), inv, out.pixel(roi.x0, y));
+  });
+}
+
+void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& fov, const std::string& filter,
+                   const PlaneBox& pb, const std::function<void(std::string)>& note, int nthreads, Guides& g) {
+  g.pb = pb;
+  g.colour = false;
+  g.colour_a.clear();
+  g.used.clear();
+  std::size_t used_guides = 0;  // g.list entries keep their memory for the next frame
+  const Roi& box = pb.box;
+
+  // k_f: a constant, plus a plane when the foveated sigma varies.
+  auto k_of = [&](const std::string& name, float& k_const, std::vector<float>& k) {
+    const FoveatedValue sigma = fov.param(name);
+    k_const = k_of_sigma(sigma.inner);
+    if (!sigma.varies) {
+      k.clear();
+      return;
+    }
+    pb.prepare(k);
+    parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+      for (int x = box.x0; x < box.x1; ++x) k[pb.index(x, y)] = k_of_sigma(sigma.at(fov.blend_at(x, y)));
+    });
+  };
+
+  for (Feature f : kFeatures) {
+    const std::string name = feature_name(f);
+    const std::string mode = params.get_enum("use_" + name);
+    if (mode == "off") continue;
+    if (f == Feature::Colour) {
+      g.colour = true;
+      // The colour weight is kept as a = sqrt(k): see CrossPass::colour_a.
+      const FoveatedValue sigma = fov.param(name + "_sigma");
+      auto a_of = [](double sg) { return float(1.0 / (std::sqrt(2.0) * sg)); };
+      g.colour_a_const = a_of(sigma.inner);
+      if (sigma.varies) {
+        pb.prepare(g.colour_a);
+        parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+          for (int x = box.x0; x < box.x1; ++x) g.colour_a[pb.index(x, y)] = a_of(sigma.at(fov.blend_at(x, y)));
+        });
+      }
+      g.used.push_back(name);
+      continue;
+    }
+    const Pass* pass = frame.find(feature_role(f));
+    if (!pass) {
+      if (mode == "on")
+        throw Error(Errc::MissingPass, "filter '" + filter + "': use_" + name + "=on needs the " + name +
+                                           " pass, absent in '" + frame.path + "'");
+      note(name + " weight dropped: no " + name + " pass in '" + frame.path + "' (use_" + name + "=auto)");
+      continue;
+    }
+    if (g.list.size() <= used_guides) g.list.emplace_back();
+    Guides::Guide& gd = g.list[used_guides++];
+    gd.feature = f;
+    gd.channels = f == Feature::Depth ? 1 : 3;
+    for (int c = 0; c < 3; ++c) {
+      if (c < gd.channels) pb.prepare(gd.c[c]);
+      else gd.c[c].clear();
+    }
+    k_of(name + "_sigma", gd.k_const, gd.k);
+    const Image& im = pass->image;
+    const int ch = im.channels();
+    std::vector<unsigned char> bad_row(std::size_t(std::max(0, box.height())), 0);
+    parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+      const std::size_t i0 = pb.index(box.x0, y);
+      const float* v = im.pixel(box.x0, y);
+      float* c[3] = {gd.c[0].data() + i0, gd.channels == 3 ? gd.c[1].data() + i0 : nullptr,
+                     gd.channels == 3 ? gd.c[2].data() + i0 : nullptr};
+      std::vector<float> finite(std::size_t(box.width()));
+      float* ok = finite.data();
+      if (gd.channels == 3 && ch == 3) split_rgb3(v, box.width(), FLT_MAX, c[0], c[1], c[2], ok);
+      else split_any(v, ch, box.width(), gd.channels, FLT_MAX, c, ok);
+      int bad = 0;
+      for (int x = 0; x < box.width(); ++x) bad += ok[x] == 0.0f;
+      bad_row[std::size_t(y - box.y0)] = bad > 0;
+    });
+    if (std::find(bad_row.begin(), bad_row.end(), 1) != bad_row.end()) {
+      // Some centres ignore this feature: k becomes a plane, 0 where the value is not finite.
+      if (gd.k.empty()) pb.prepare(gd.k, gd.k_const);
+      parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+        if (!bad_row[std::size_t(y - box.y0)]) return;
+        for (int x = box.x0; x < box.x1; ++x) {
+          const float* v = im.pixel(x, y);
+          bool finite = true;
+          for (int c = 0; c < gd.channels; ++c) finite = finite && std::isfinite(v[std::min(c, ch - 1)]);
+          if (!finite) gd.k[pb.index(x, y)] = 0.0f;
+        }
+      });
+    }
+    g.used.push_back(name);
+  }
+  g.list.resize(used_guides);
+
+  pb.prepare(g.ok, 1.0f);
+  for (const Guides::Guide& gd : g.list)
+    if (!gd.k.empty())  // k >= 5e-13 for any sigma in range: 0 marks exactly the non-finite values
+      parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
+        for (int x = box.x0; x < box.x1; ++x)
+          if (gd.k[pb.index(x, y)] == 0.0f) g.ok[pb.index(x, y)] = 0.0f;
+      });
+}
+
+// ---------------------------------------------------------------------------
+// The kernel: W pixels of a row at once, every tap of the grid in turn, the
+// centre's values and the sums in registers. Written once over GCC vector
+// extensions and compiled for three instruction sets.
+
+namespace {
+
+template <int W>
+struct Vec {
+  typedef float f __attribute__((vector_size(4 * W)));
+  typedef std::int32_t i __attribute__((vector_size(4 * W)));
+};
+
+#define MCR_INLINE inline __attribute__((always_inline))
+
+template <int W>
+MCR_INLINE typename Vec<W>::f splat(float v) {
+  typename Vec<W>::f r = {};
+  return r + v;
+}
+
+// exp(-e) for e >= 0: exact 1 at 0, 0 for e >= 86 and for NaN / +inf, else
+// within 2e-7 relative: e^x = 2^n e^r with n = round(x / ln2), r = x - n ln2
+// (ln2 split in two so that r is exact: Cody & Waite), e^r by Taylor to r^6.
+template <int W>
+MCR_INLINE typename Vec<W>::f exp_neg_v(typename Vec<W>::f e) {
+  using vf = typename Vec<W>::f;
+  using vi = typename Vec<W>::i;
+  const vi ok = e < splat<W>(86.0f);
+  const vf x = ok ? -e : splat<W>(0.0f);
+  const vf n = (x * 1.44269504f + 12582912.0f) - 12582912.0f;  // round(x log2 e) (1.5 * 2^23 trick)
+  const vf r = (x - n * 0.693359375f) - n * -2.12194440e-4f;   // ln2 = 0.693359375 - 2.12194440e-4
+  vf p = r * (1.0f / 720.0f) + (1.0f / 120.0f);               // |r| <= 0.347: Taylor error < 1.3e-7
+  p = p * r + (1.0f / 24.0f);
+  p = p * r + (1.0f / 6.0f);
+  p = p * r + 0.5f;
+  p = p * r + 1.0f;
+  p = p * r + 1.0f;
+  const vi bits = (__builtin_convertvector(n, vi) + 127) << 23;  // 2^n, n >= -125 here
+  vf scale;
+  std::memcpy(&scale, &bits, sizeof scale);
+  return ok ? p * scale : splat<W>(0.0f);
+}
+
+template <int W>
+MCR_INLINE typename Vec<W>::f load_full(const float* row, int x) {
+  typename Vec<W>::f v;
+  std::memcpy(&v, row + x, sizeof v);
+  return v;
+}
+
+// Per-pixel plane or constant.
+template <int W>
+MCR_INLINE typename Vec<W>::f load_or(const float* plane, float c, std::size_t row, int x) {
+  return plane ? load_full<W>(plane + row, x) : splat<W>(c);
+}
+
+template <int W, int N3>
+struct Centre {
+  using vf = typename Vec<W>::f;
+  vf c[3];                   // colour
+  vf ac;                     // colour sqrt(k) (0 when the colour is unusable)
+  vf g[N3 > 0 ? N3 : 1][3];  // three-channel guides
+  vf kg[N3 > 0 ? N3 : 1];
+  vf d, kd;                  // depth
+  vf s, r;                   // spatial coefficient, window radius
+  vf cok;                    // colour usable
+};
+
+template <int W>
+struct Acc {
+  typename Vec<W>::f c0, c1, c2, w;
+};
+
+struct Flags {
+  bool depth, spatial, radius;
+};
+
+// The guide planes of one pass, sorted: three-channel ones, then depth.
+template <int N3>
+struct GuidePlanes {
+  const float* g3[3 * (N3 > 0 ? N3 : 1)] = {};
+  const Guides::Guide* gg3[N3 > 0 ? N3 : 1] = {};
+  const Guides::Guide* ggd = nullptr;
+  const float* gd = nullptr;
+  explicit GuidePlanes(const CrossPass& a) {
+    int j = 0;
+    for (const Guides::Guide* g : a.guides) {
+      if (g->channels == 3 && j < N3) {
+        for (int c = 0; c < 3; ++c) g3[3 * j + c] = g->c[c].data();
+        gg3[j++] = g;
+      } else if (g->channels == 1) {
+        ggd = g;
+      }
+    }
+    gd = ggd ? ggd->c[0].data() : nullptr;
+  }
+};
+
+template <int W, bool C, int N3>
+MCR_INLINE void load_centre(const CrossPass& a, const GuidePlanes<N3>& gp, Flags fl, std::size_t crow, int x,
+                            Centre<W, N3>& p) {
+  constexpr float amax = 1e18f;
+  for (int c = 0; c < 3; ++c) p.c[c] = load_full<W>(a.colour[c] + crow, x);
+  p.cok = load_full<W>(a.colour_ok + crow, x);
+  if constexpr (C) {
+    // a stays finite (a * 0 = 0 for equal colours, never inf * 0).
+    const typename Vec<W>::f ac = load_or<W>(a.colour_a, a.colour_a_const, crow, x) * a.colour_amul;
+    p.ac = (ac < amax ? ac : splat<W>(amax)) * p.cok;
+  } else {
+    p.ac = splat<W>(0.0f);
+  }
+  for (int j = 0; j < N3; ++j) {
+    for (int c = 0; c < 3; ++c) p.g[j][c] = load_full<W>(gp.g3[3 * j + c] + crow, x);
+    p.kg[j] = load_or<W>(gp.gg3[j]->k.empty() ? nullptr : gp.gg3[j]->k.data(), gp.gg3[j]->k_const, crow, x);
+  }
+  if (gp.ggd) {
+    p.d = load_full<W>(gp.gd + crow, x);
+    p.kd = load_or<W>(gp.ggd->k.empty() ? nullptr : gp.ggd->k.data(), gp.ggd->k_const, crow, x);
+  } else {
+    p.d = p.kd = splat<W>(0.0f);
+  }
+  p.s = load_or<W>(a.s, a.s_const, crow, x);
+  p.r = fl.radius ? load_full<W>(a.radius + crow, x) : splat<W>(0.0f);
+}
+
+// Tap (dx, dy) for a block of W pixels: qrow + qu addresses the first pixel's
+// neighbour; the padded rows keep every load in bounds (lanes past the image read
+// 0 with valid 0).
+template <int W, bool C, int N3>
+MCR_INLINE void tap(const CrossPass& a, const Centre<W, N3>& pu, const GuidePlanes<N3>& gp, Flags fl,
+                    std::size_t qrow, int qu, float h, float d2, float m, Acc<W>& acc) {
+  using vf = typename Vec<W>::f;
+  const auto ld = [](const float* row, int x) { return load_full<W>(row, x); };
+  const vf q0 = ld(a.colour[0] + qrow, qu);
+  const vf q1 = ld(a.colour[1] + qrow, qu);
+  const vf q2 = ld(a.colour[2] + qrow, qu);
+  vf e = fl.spatial ? pu.s * d2 : splat<W>(0.0f);
+  if constexpr (C) {
+    const vf du = (pu.c[0] - q0) * pu.ac, dv = (pu.c[1] - q1) * pu.ac, dw = (pu.c[2] - q2) * pu.ac;
+    e = du * du + dv * dv + dw * dw + e;
+  }
+  for (int j = 0; j < N3; ++j) {
+    const vf du = pu.g[j][0] - ld(gp.g3[3 * j + 0] + qrow, qu);
+    const vf dv = pu.g[j][1] - ld(gp.g3[3 * j + 1] + qrow, qu);
+    const vf dw = pu.g[j][2] - ld(gp.g3[3 * j + 2] + qrow, qu);
+    e = pu.kg[j] * (du * du + dv * dv + dw * dw) + e;
+  }
+  if (fl.depth) {
+    const vf du = pu.d - ld(gp.gd + qrow, qu);
+    e = pu.kd * (du * du) + e;
+  }
+  vf w = exp_neg_v<W>(e) * (ld(a.valid + qrow, qu) * h);
+  if (fl.radius) w = splat<W>(m) <= pu.r ? w : splat<W>(0.0f);
+  acc.c0 = w * q0 + acc.c0;
+  acc.c1 = w * q1 + acc.c1;
+  acc.c2 = w * q2 + acc.c2;
+  acc.w = acc.w + w;
+}
+
+// The block of W pixels starting at x (box coordinates) of row y; `lanes` pixels
+// of it belong to the region and are stored.
+template <int W, bool C, int N3>
+MCR_INLINE void cross_block(const CrossPass& a, const GuidePlanes<N3>& gp, Flags fl, int y, int x, int lanes) {
+  using vf = typename Vec<W>::f;
+  using vi = typename Vec<W>::i;
+  const int bw = a.pb.box.width(), bh = a.pb.box.height();
+  const int n = int(a.off.size());
+  const std::size_t crow = std::size_t(y) * std::size_t(a.pb.stride) + kPlanePad;
+  Centre<W, N3> p;
+  load_centre<W, C, N3>(a, gp, fl, crow, x, p);
+  int rb = 1 << 30;  // taps beyond every lane's window are skipped
+  if (fl.radius) {
+    float mr = 0.0f;
+    for (int l = 0; l < lanes; ++l) mr = std::max(mr, p.r[l]);
+    rb = int(mr);
+  }
+
+  Acc<W> acc{splat<W>(0.0f), splat<W>(0.0f), splat<W>(0.0f), splat<W>(0.0f)};
+  for (int j = 0; j < n; ++j) {
+    const int dy = a.off[j];
+    if (std::abs(dy) > rb) continue;
+    const int qy = y + dy;
+    if (qy < 0 || qy >= bh) continue;
+    const std::size_t qrow = std::size_t(qy) * std::size_t(a.pb.stride) + kPlanePad;
+    const float hy = a.h[j];
+    for (int i = 0; i < n; ++i) {
+      const int dx = a.off[i];
+      if (std::abs(dx) > rb) continue;
+      const int qx = x + dx;
+      if (qx + W <= 0 || qx >= bw) continue;  // every lane outside the image
+      const float h = a.h[i] * hy;
+      const float d2 = float(dx * dx + dy * dy);
+      const float m = float(std::max(std::abs(dx), std::abs(dy)));
+      tap<W, C, N3>(a, p, gp, fl, qrow, qx, h, d2, m, acc);
+    }
+  }
+
+  const vi has = acc.w > 0.0f;
+  const vf wsafe = has ? acc.w : splat<W>(1.0f);
+  const vf o0 = has ? acc.c0 / wsafe : p.c[0];  // no usable tap: own colour (0 when unusable)
+  const vf o1 = has ? acc.c1 / wsafe : p.c[1];
+  const vf o2 = has ? acc.c2 / wsafe : p.c[2];
+  const vf ook = (has | (p.cok > 0.0f)) ? splat<W>(1.0f) : splat<W>(0.0f);
+  const std::size_t i = crow + std::size_t(x);
+  if (lanes == W) {
+    std::memcpy(a.out[0] + i, &o0, sizeof o0);
+    std::memcpy(a.out[1] + i, &o1, sizeof o1);
+    std::memcpy(a.out[2] + i, &o2, sizeof o2);
+    if (a.out_ok) std::memcpy(a.out_ok + i, &ook, sizeof ook);
+  } else {
+    for (int l = 0; l < lanes; ++l) {
+      a.out[0][i + l] = o0[l];
+      a.out[1][i + l] = o1[l];
+      a.out[2][i + l] = o2[l];
+      if (a.out_ok) a.out_ok[i + l] = ook[l];
+    }
+  }
+}
+
+// One row y (box coordinates) of the region's columns [x0, x1), W pixels at a time.
+template <int W, bool C, int N3>
+MCR_INLINE void cross_row_impl(const CrossPass& a, int y, int x0, int x1) {
+  const GuidePlanes<N3> gp(a);
+  const Flags fl{gp.ggd != nullptr, a.s != nullptr || a.s_const != 0.0f, a.radius != nullptr};
+  for (int x = x0; x < x1; x += W) cross_block<W, C, N3>(a, gp, fl, y, x, std::min(W, x1 - x));
+}
+
+using RowFn = void (*)(const CrossPass&, int, int, int);
+
+template <bool C, int N3>
+void row_generic(const CrossPass& a, int y, int x0, int x1) {
+  cross_row_impl<4, C, N3>(a, y, x0, x1);
+}
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_X86_DISPATCH 1
+// Same source; the attributes let GCC use the wider registers and contract a*b+c to FMA.
+template <bool C, int N3>
+__attribute__((target("avx2,fma"), optimize("fp-contract=fast"), flatten)) void row_avx2(const CrossPass& a, int y,
+                                                                                         int x0, int x1) {
+  cross_row_impl<8, C, N3>(a, y, x0, x1);
+}
+template <bool C, int N3>
+__attribute__((target("avx512f,fma"), optimize("fp-contract=fast"), flatten)) void row_avx512(const CrossPass& a,
+                                                                                             int y, int x0, int x1) {
+  cross_row_impl<16, C, N3>(a, y, x0, x1);
+}
+#endif
+
+enum class Isa { Generic, Avx2, Avx512 };
+
+Isa best_isa() {
+#ifdef MCR_X86_DISPATCH
+  __builtin_cpu_init();
+  if (__builtin_cpu_supports("avx512f")) return Isa::Avx512;
+  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return Isa::Avx2;
+#endif
+  return Isa::Generic;
+}
+
+std::atomic<int>& isa_choice() {
+  static std::atomic<int> choice{int(best_isa())};
+  return choice;
+}
+
+Isa isa() { return Isa(isa_choice().load(std::memory_order_relaxed)); }
+
+// Index: bit 2 colour weight, bits 0-1 number of three-channel guides.
+template <template <bool, int> class Row, std::size_t... I>
+constexpr std::array<RowFn, sizeof...(I)> make_table(std::index_sequence<I...>) {
+  return {Row<bool((I >> 2) & 1), int(I & 3)>::fn...};
+}
+template <bool C, int N3>
+struct Generic {
+  static constexpr RowFn fn = &row_generic<C, N3>;
+};
+#ifdef MCR_X86_DISPATCH
+template <bool C, int N3>
+struct Avx2 {
+  static constexpr RowFn fn = &row_avx2<C, N3>;
+};
+template <bool C, int N3>
+struct Avx512 {
+  static constexpr RowFn fn = &row_avx512<C, N3>;
+};
+#endif
+
+RowFn pick_row_fn(bool c, int n3) {
+  const std::size_t index = (std::size_t(c) << 2) | std::size_t(n3);
+  static const auto generic = make_table<Generic>(std::make_index_sequence<8>{});
+#ifdef MCR_X86_DISPATCH
+  static const auto avx2 = make_table<Avx2>(std::make_index_sequence<8>{});
+  static const auto avx512 = make_table<Avx512>(std::make_index_sequence<8>{});
+  switch (isa()) {
+    case Isa::Avx512: return avx512[index];
+    case Isa::Avx2: return avx2[index];
+    case Isa::Generic: break;
+  }
+#endif
+  return generic[index];
+}
+
+}  // namespace
+
+bool set_cross_filter_isa(const std::string& name) {
+  const Isa best = best_isa();
+  Isa want = best;
+  if (name == "generic") want = Isa::Generic;
+  else if (name == "avx2") want = Isa::Avx2;
+  else if (name == "avx512") want = Isa::Avx512;
+  else if (!name.empty()) return false;
+  if (int(want) > int(best)) return false;  // the CPU lacks it
+  isa_choice().store(int(want), std::memory_order_relaxed);
+  return true;
+}
+
+const char* cross_filter_isa() {
+  switch (isa()) {
+    case Isa::Avx512: return "avx512";
+    case Isa::Avx2: return "avx2";
+    case Isa::Generic: break;
+  }
+  return "generic";
+}
+
+void cross_filter(const CrossPass& a, const Roi& region, int nthreads) {
+  if (region.empty()) return;
+  int n3 = 0;
+  bool depth = false;
+  for (const Guides::Guide* g : a.guides) {
+    if (g->channels == 3) ++n3;
+    else if (depth) throw Error(Errc::Internal, "cross_filter: more than one one-channel guide");
+    else depth = true;
+  }
+  if (n3 > 3) throw Error(Errc::Internal, "cross_filter: more than three three-channel guides");
+  if (a.off.empty() || a.off.size() != a.h.size()) throw Error(Errc::Internal, "cross_filter: bad tap grid");
+  const RowFn fn = pick_row_fn(a.colour_weight, n3);
+  const Roi& box = a.pb.box;
+  if (region.x0 < box.x0 || region.y0 < box.y0 || region.x1 > box.x1 || region.y1 > box.y1)
+    throw Error(Errc::Internal, "cross_filter: region outside the planes");
+  const int bx = region.x0 - box.x0, ex = region.x1 - box.x0;
+  parallel_rows(region.y0, region.y1, nthreads, [&](int y) { fn(a, y - box.y0, bx, ex); });
+}
+
+float fast_exp_neg(float e) { return exp_neg_v<8>(splat<8>(e))[0]; }
+
+}  // namespace mcr

@@ -1,0 +1,479 @@
+// Cross-bilateral filter against a brute-force double-precision reference of
+//   w(p,q) = exp(-|q-p|^2/(2 s^2)) prod_f exp(-|f(p)-f(q)|^2/(2 sigma_f^2))
+// with the documented non-finite policy, plus closed forms and stress cases.
+#include "filters/bilateral.h"
+
+#include <gtest/gtest.h>
+
+#include <cfloat>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <random>
+#include <vector>
+
+#include "filters/feature_weights.h"
+#include "filters/foveation.h"
+#include "filters/registry.h"
+#include "util/error.h"
+
+namespace mcr {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+const char* kFeatureNames[5] = {"colour", "normal", "position", "albedo", "depth"};
+const Role kFeatureRoles[5] = {Role::Colour, Role::Normal, Role::Position, Role::Albedo, Role::Depth};
+
+using Params = std::map<std::string, ParamValue>;
+
+Image random_image(int w, int h, int ch, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> dist(lo, hi);
+  Image im(w, h, ch);
+  for (float& v : im.storage()) v = dist(rng);
+  return im;
+}
+
+void add_pass(Frame& f, Role role, Image im) {
+  Pass p;
+  p.role = role;
+  p.name = role_name(role);
+  p.image = std::move(im);
+  f.passes.push_back(std::move(p));
+}
+
+Frame colour_frame(const Image& colour) {
+  Frame f;
+  f.width = colour.width();
+  f.height = colour.height();
+  f.path = "test.exr";
+  add_pass(f, Role::Colour, colour);
+  return f;
+}
+
+// Colour plus every feature, random.
+Frame full_frame(int w, int h, unsigned seed) {
+  Frame f = colour_frame(random_image(w, h, 3, seed));
+  add_pass(f, Role::Normal, random_image(w, h, 3, seed + 1, -1.0f, 1.0f));
+  add_pass(f, Role::Position, random_image(w, h, 3, seed + 2, 0.0f, 2.0f));
+  add_pass(f, Role::Albedo, random_image(w, h, 3, seed + 3, 0.1f, 1.0f));
+  add_pass(f, Role::Depth, random_image(w, h, 1, seed + 4, 1.0f, 3.0f));
+  return f;
+}
+
+Image& pass_image(Frame& f, Role r) {
+  for (Pass& p : f.passes)
+    if (p.role == r) return p.image;
+  throw std::runtime_error("no pass");
+}
+
+struct Result {
+  Image out;
+  std::size_t repaired = 0;
+  std::vector<std::string> notes;
+};
+
+Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi roi = {}) {
+  BilateralFilter f;
+  for (const auto& [k, v] : params) f.set(k, v);
+  f.commit();
+  ExecOptions eo;
+  eo.nthreads = nthreads;
+  eo.roi = roi;
+  Result r;
+  r.out = f.execute(frame, eo);
+  r.repaired = f.nonfinite_repaired();
+  r.notes = f.notes();
+  return r;
+}
+
+Params all_off() {
+  Params p;
+  for (const char* n : kFeatureNames) p[std::string("use_") + n] = std::string("off");
+  return p;
+}
+
+Params with(Params p, const Params& more) {
+  for (const auto& [k, v] : more) p[k] = v;
+  return p;
+}
+
+// Sigmas wide enough that random features still let neighbours mix (the
+// defaults make random data close to the identity, which would prove little).
+Params mild() {
+  return {{"spatial_sigma", 1.5}, {"colour_sigma", 0.8}, {"normal_sigma", 1.0}, {"position_sigma", 1.5},
+          {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
+}
+
+// Fraction of values that moved by more than 1e-3: the filter did something.
+double changed(const Image& out, const Image& in) {
+  std::size_t n = 0;
+  for (std::size_t i = 0; i < out.storage().size(); ++i) n += std::fabs(out.storage()[i] - in.storage()[i]) > 1e-3f;
+  return double(n) / double(out.storage().size());
+}
+
+bool finite_n(const float* p, int n) {
+  for (int i = 0; i < n; ++i)
+    if (!std::isfinite(p[i])) return false;
+  return true;
+}
+
+// Reference: the filter's documented definition, in double, straight loops.
+Image reference(const Frame& frame, const Params& given) {
+  BilateralFilter probe;
+  for (const auto& [k, v] : given) probe.set(k, v);
+  const ParamSet& ps = probe.params();
+  const int w = frame.width, h = frame.height;
+  const double ss = ps.get_float("spatial_sigma");
+  const int fixed = int(ps.get_int("radius"));
+  const int r = ss > 0 ? (fixed > 0 ? fixed : int(std::ceil(3 * ss - 1e-6))) : 0;
+  struct F {
+    const Image* im;
+    int ch;
+    double k;
+  };
+  std::vector<F> feats;
+  const Image& colour = frame.image(Role::Colour);
+  for (int i = 0; i < 5; ++i) {
+    const std::string n = kFeatureNames[i];
+    if (ps.get_enum("use_" + n) == "off" || !frame.has(kFeatureRoles[i])) continue;
+    const double s = ps.get_float(n + "_sigma");
+    feats.push_back({&frame.image(kFeatureRoles[i]), i == 4 ? 1 : 3, 1.0 / (2 * s * s)});
+  }
+  Image out(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      double s[3] = {0, 0, 0}, sw = 0;
+      for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
+        for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
+          const float* cq = colour.pixel(qx, qy);
+          bool usable = finite_n(cq, 3);
+          for (const F& f : feats) usable = usable && finite_n(f.im->pixel(qx, qy), f.ch);
+          if (!usable) continue;
+          const double d2 = double(qx - x) * (qx - x) + double(qy - y) * (qy - y);
+          double e = ss > 0 ? d2 / (2 * ss * ss) : 0.0;
+          for (const F& f : feats) {
+            const float* a = f.im->pixel(x, y);
+            const float* b = f.im->pixel(qx, qy);
+            if (!finite_n(a, f.ch)) continue;  // own value not finite: this feature is skipped
+            double dd = 0;
+            for (int c = 0; c < f.ch; ++c) dd += (double(a[c]) - b[c]) * (double(a[c]) - b[c]);
+            e += f.k * dd;
+          }
+          const double wq = std::exp(-e);
+          for (int c = 0; c < 3; ++c) s[c] += wq * cq[c];
+          sw += wq;
+        }
+      const float* cp = colour.pixel(x, y);
+      for (int c = 0; c < 3; ++c)
+        out.at(x, y, c) = float(sw > 0 ? s[c] / sw : (finite_n(cp, 3) ? cp[c] : 0.0));
+    }
+  return out;
+}
+
+void expect_close(const Image& got, const Image& want, double rel, const char* what = "") {
+  ASSERT_EQ(got.width(), want.width());
+  ASSERT_EQ(got.height(), want.height());
+  for (int y = 0; y < got.height(); ++y)
+    for (int x = 0; x < got.width(); ++x)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(got.at(x, y, c), want.at(x, y, c), rel * std::max(1.0f, std::fabs(want.at(x, y, c))))
+            << what << " pixel " << x << "," << y << " channel " << c;
+}
+
+TEST(BilateralFilterTest, FastExpIsAccurate) {
+  EXPECT_EQ(fast_exp_neg(0.0f), 1.0f);
+  for (float e = 1e-6f; e < 86.0f; e *= 1.07f) {
+    const double want = std::exp(-double(e));
+    EXPECT_NEAR(fast_exp_neg(e), want, 3e-7 * want) << e;
+  }
+  EXPECT_EQ(fast_exp_neg(86.0f), 0.0f);
+  EXPECT_EQ(fast_exp_neg(1e30f), 0.0f);
+  EXPECT_EQ(fast_exp_neg(kInf), 0.0f);
+  EXPECT_EQ(fast_exp_neg(kNaN), 0.0f);
+}
+
+// Every feature weight off: a plain Gaussian convolution, clipped and renormalised.
+TEST(BilateralFilterTest, AllWeightsOffIsGaussianConvolution) {
+  const Frame f = full_frame(27, 19, 1);
+  for (double ss : {0.6, 1.5, 2.2}) {
+    SCOPED_TRACE(ss);
+    const Image got = run_on(f, with(all_off(), {{"spatial_sigma", ss}})).out;
+    const Image& in = f.image(Role::Colour);
+    const int r = int(std::ceil(3 * ss - 1e-6));
+    for (int y = 0; y < f.height; ++y)
+      for (int x = 0; x < f.width; ++x) {
+        double s[3] = {0, 0, 0}, sw = 0;
+        for (int dy = -r; dy <= r; ++dy)
+          for (int dx = -r; dx <= r; ++dx) {
+            if (x + dx < 0 || y + dy < 0 || x + dx >= f.width || y + dy >= f.height) continue;
+            const double wq = std::exp(-(dx * dx + dy * dy) / (2 * ss * ss));
+            for (int c = 0; c < 3; ++c) s[c] += wq * in.at(x + dx, y + dy, c);
+            sw += wq;
+          }
+        for (int c = 0; c < 3; ++c) ASSERT_NEAR(got.at(x, y, c), s[c] / sw, 1e-5) << x << "," << y;
+      }
+  }
+}
+
+TEST(BilateralFilterTest, MatchesReferenceWithEveryFeature) {
+  const Frame f = full_frame(33, 21, 2);
+  const Params p = {{"spatial_sigma", 1.7}, {"colour_sigma", 0.4}, {"normal_sigma", 0.8}, {"position_sigma", 0.9},
+                    {"albedo_sigma", 0.5}, {"use_depth", std::string("on")}, {"depth_sigma", 0.7}};
+  expect_close(run_on(f, p).out, reference(f, p), 1e-4);
+  // One, two, three features, and a fixed radius larger than 3 sigma.
+  expect_close(run_on(f, with(all_off(), {{"use_colour", std::string("on")}})).out,
+               reference(f, with(all_off(), {{"use_colour", std::string("on")}})), 1e-4, "colour");
+  const Params two = with(all_off(), {{"use_colour", std::string("on")}, {"use_normal", std::string("on")}});
+  expect_close(run_on(f, two).out, reference(f, two), 1e-4, "two");
+  const Params three = with(two, {{"use_position", std::string("on")}, {"radius", std::int64_t(7)}});
+  expect_close(run_on(f, three).out, reference(f, three), 1e-4, "three");
+}
+
+TEST(BilateralFilterTest, TinyFeatureSigmaIsIdentity) {
+  Frame f = full_frame(20, 14, 3);  // random normals: every pair differs
+  for (const char* n : {"normal", "position", "albedo", "colour"}) {
+    SCOPED_TRACE(n);
+    const Params p = with(all_off(), {{std::string("use_") + n, std::string("on")}, {std::string(n) + "_sigma", 1e-6}});
+    const Image out = run_on(f, p).out;
+    EXPECT_EQ(out.storage(), f.image(Role::Colour).storage());
+  }
+}
+
+TEST(BilateralFilterTest, HugeFeatureSigmaIsGaussian) {
+  const Frame f = full_frame(20, 14, 4);
+  const Image gauss = run_on(f, with(all_off(), {{"spatial_sigma", 1.2}})).out;
+  const Params p = {{"spatial_sigma", 1.2}, {"colour_sigma", 1e6}, {"normal_sigma", 1e6}, {"position_sigma", 1e6},
+                    {"albedo_sigma", 1e6}, {"use_depth", std::string("on")}, {"depth_sigma", 1e6}};
+  expect_close(run_on(f, p).out, gauss, 1e-5);
+}
+
+TEST(BilateralFilterTest, SpatialSigmaLimits) {
+  const Frame f = full_frame(15, 10, 5);
+  EXPECT_EQ(run_on(f, {{"spatial_sigma", 0.0}}).out.storage(), f.image(Role::Colour).storage());
+  const Params big = {{"spatial_sigma", 21.0}};  // radius 63 over a 15x10 image
+  expect_close(run_on(f, big).out, reference(f, big), 1e-4);
+  BilateralFilter b;
+  EXPECT_THROW(b.set("spatial_sigma", 22.0), Error);
+  EXPECT_THROW(b.set("normal_sigma", 0.0), Error);  // off is use_normal=off, never sigma 0
+  EXPECT_THROW(b.set("radius", std::int64_t(65)), Error);
+}
+
+// Left half faces +z, right half +x; colours differ across the edge. With the
+// normal weight only, pixels next to the edge average their own side only.
+TEST(BilateralFilterTest, NormalAndPositionEdgesArePreserved) {
+  const int w = 32, h = 24;
+  Image colour = random_image(w, h, 3, 6, -0.05f, 0.05f);
+  Image normal(w, h, 3, 0.0f), position(w, h, 3, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const bool left = x < w / 2;
+      for (int c = 0; c < 3; ++c) colour.at(x, y, c) += left ? 0.2f : 0.8f;
+      normal.at(x, y, left ? 2 : 0) = 1.0f;
+      position.at(x, y, 2) = left ? 0.0f : 5.0f;  // a depth step
+    }
+  for (Role guide : {Role::Normal, Role::Position}) {
+    Frame f = colour_frame(colour);
+    add_pass(f, guide, guide == Role::Normal ? normal : position);
+    const Params p = with(all_off(), {{"spatial_sigma", 3.0},
+                                      {guide == Role::Normal ? "use_normal" : "use_position", std::string("on")},
+                                      {"normal_sigma", 0.1},
+                                      {"position_sigma", 0.1}});
+    const Image out = run_on(f, p).out;
+    double var_in = 0, var_out = 0;
+    for (int y = 0; y < h; ++y) {
+      EXPECT_NEAR(out.at(w / 2 - 1, y, 0), 0.2f, 0.03f) << "left of the edge, row " << y;
+      EXPECT_NEAR(out.at(w / 2, y, 1), 0.8f, 0.03f) << "right of the edge, row " << y;
+      for (int x = 2; x < 10; ++x) {
+        var_in += std::pow(colour.at(x, y, 0) - 0.2, 2);
+        var_out += std::pow(out.at(x, y, 0) - 0.2, 2);
+      }
+    }
+    EXPECT_LT(var_out, 0.1 * var_in) << "flat regions are smoothed";
+  }
+}
+
+TEST(BilateralFilterTest, ColourWeightStopsFireflies) {
+  Image in(15, 15, 3, 0.5f);
+  in.at(7, 7, 0) = 1e6f;
+  Frame f = colour_frame(in);
+  const Image out = run_on(f, with(all_off(), {{"use_colour", std::string("on")}, {"spatial_sigma", 2.0}})).out;
+  EXPECT_FLOAT_EQ(out.at(8, 7, 0), 0.5f);  // neighbours ignore it
+  const Image clamped =
+      run_on(f, with(all_off(), {{"use_colour", std::string("on")}, {"clamp", 1.0}, {"spatial_sigma", 2.0}})).out;
+  EXPECT_LE(clamped.at(7, 7, 0), 1.0f);
+}
+
+TEST(BilateralFilterTest, AbsentFeaturesAreDroppedWithANoteOrRequired) {
+  const Frame f = colour_frame(random_image(10, 8, 3, 7));
+  Result r = run_on(f, {});
+  bool normal_note = false, position_note = false;
+  for (const std::string& n : r.notes) {
+    normal_note = normal_note || n.find("normal weight dropped") != std::string::npos;
+    position_note = position_note || n.find("position weight dropped") != std::string::npos;
+  }
+  EXPECT_TRUE(normal_note);
+  EXPECT_TRUE(position_note);
+  expect_close(r.out, reference(f, {}), 1e-4);
+  try {
+    run_on(f, {{"use_normal", std::string("on")}});
+    FAIL() << "use_normal=on without a normal pass must throw";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), Errc::MissingPass);
+    EXPECT_NE(std::string(e.what()).find("normal"), std::string::npos);
+    EXPECT_NE(std::string(e.what()).find("test.exr"), std::string::npos);
+  }
+  EXPECT_TRUE(run_on(f, with(all_off(), {})).notes.empty());
+}
+
+TEST(BilateralFilterTest, ConstantImageAndEqualFeatures) {
+  for (float v : {0.0f, 0.375f, -2.5f, 1e-30f, 1e30f, 3.3e38f, FLT_MAX}) {
+    Frame f = colour_frame(Image(13, 9, 3, v));
+    add_pass(f, Role::Normal, Image(13, 9, 3, 0.5f));
+    add_pass(f, Role::Position, Image(13, 9, 3, v));  // all-equal features, even huge
+    add_pass(f, Role::Albedo, Image(13, 9, 3, 0.0f));
+    Result r = run_on(f, {{"spatial_sigma", 2.0}});
+    EXPECT_EQ(r.repaired, 0u);
+    for (float o : r.out.storage()) ASSERT_NEAR(o, v, 1e-6 * std::fabs(v)) << "constant " << v;
+  }
+}
+
+TEST(BilateralFilterTest, DegenerateShapes) {
+  for (auto [w, h] : {std::pair{1, 1}, std::pair{1, 9}, std::pair{9, 1}, std::pair{2, 1}, std::pair{1, 2},
+                      std::pair{17, 3}}) {
+    SCOPED_TRACE(testing::Message() << w << "x" << h);
+    const Frame f = full_frame(w, h, unsigned(w * 31 + h));
+    expect_close(run_on(f, mild()).out, reference(f, mild()), 1e-4);
+  }
+}
+
+TEST(BilateralFilterTest, TinyAndHugeValues) {
+  Image in(30, 20, 3, 1e-30f);
+  in.at(5, 5, 0) = 1e30f;
+  in.at(5, 5, 1) = -1e30f;
+  Frame f = colour_frame(in);
+  add_pass(f, Role::Normal, random_image(30, 20, 3, 8));
+  add_pass(f, Role::Position, Image(30, 20, 3, 1e30f));
+  for (const Params& p : {with(mild(), {{"use_depth", std::string("off")}}), with(all_off(), {{"spatial_sigma", 1.5}})}) {
+    Result r = run_on(f, p);
+    EXPECT_EQ(r.repaired, 0u);
+    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+    expect_close(r.out, reference(f, p), 1e-4);
+  }
+  Image big(12, 12, 3, FLT_MAX);
+  big.at(2, 2, 2) = -FLT_MAX;
+  Result b = run_on(colour_frame(big), with(all_off(), {{"spatial_sigma", 3.0}}));
+  EXPECT_EQ(b.repaired, 0u);
+  for (float v : b.out.storage()) ASSERT_TRUE(std::isfinite(v));
+}
+
+// NaN and Inf in the colour and in each feature: finite output, nothing
+// repaired by the safety net, and exactly the documented policy (the reference).
+TEST(BilateralFilterTest, NonFiniteColourAndFeaturesFollowThePolicy) {
+  const Params p = {{"spatial_sigma", 1.5}, {"colour_sigma", 0.6}, {"normal_sigma", 1.0}, {"position_sigma", 1.0},
+                    {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
+  for (Role role : kFeatureRoles) {
+    SCOPED_TRACE(role_name(role));
+    Frame f = full_frame(19, 15, 9);
+    Image& im = pass_image(f, role);
+    im.at(4, 4, 0) = kNaN;
+    im.at(10, 7, std::min(1, im.channels() - 1)) = kInf;
+    im.at(18, 14, 0) = -kInf;  // corner
+    for (int y = 0; y < 3; ++y)  // a blob: centres inside have no usable neighbour
+      for (int x = 12; x < 17; ++x) im.at(x, y, 0) = kNaN;
+    Result r = run_on(f, p);
+    EXPECT_EQ(r.repaired, 0u);
+    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+    expect_close(r.out, reference(f, p), 1e-4);
+    // A 3x3 window inside the blob has no usable sample: the pixel keeps its colour (if finite).
+    const Params narrow = with(p, {{"spatial_sigma", 0.3}});
+    const Result nr = run_on(f, narrow);
+    expect_close(nr.out, reference(f, narrow), 1e-4);
+    if (role != Role::Colour)
+      for (int c = 0; c < 3; ++c) EXPECT_EQ(nr.out.at(14, 1, c), f.image(Role::Colour).at(14, 1, c));
+    // With the feature off the non-finite values do not matter (colour aside).
+    if (role != Role::Colour) {
+      const Params off = with(p, {{std::string("use_") + role_name(role), std::string("off")}});
+      expect_close(run_on(f, off).out, reference(f, off), 1e-4);
+    }
+  }
+}
+
+TEST(BilateralFilterTest, ZeroAlbedoWithDemodulation) {
+  Frame f = full_frame(16, 12, 10);
+  Image& a = pass_image(f, Role::Albedo);
+  for (float& v : a.storage()) v = 0.0f;
+  a.at(3, 3, 0) = kNaN;
+  Result r = run_on(f, {{"demodulate", true}});
+  EXPECT_EQ(r.repaired, 0u);
+  for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+}
+
+TEST(BilateralFilterTest, IdenticalForOneAndTwoThreads) {
+  Frame f = full_frame(67, 41, 11);
+  pass_image(f, Role::Normal).at(5, 5, 1) = kNaN;
+  pass_image(f, Role::Colour).at(50, 20, 0) = kInf;
+  for (const Params& p : {mild(), with(mild(), {{"foveated", true}, {"spatial_sigma", 0.5}, {"spatial_sigma_outer", 3.0},
+                                               {"colour_sigma_outer", 2.0}, {"inner_radius", 0.05}})}) {
+    const Image one = run_on(f, p, 1).out;
+    const Image two = run_on(f, p, 2).out;
+    EXPECT_EQ(one.storage(), two.storage());
+    EXPECT_GT(changed(one, f.image(Role::Colour)), 0.3);
+  }
+}
+
+TEST(BilateralFilterTest, RegionChangesOnlyPixelsInside) {
+  const Frame f = full_frame(30, 20, 12);
+  const Roi roi{7, 3, 19, 11};
+  const Params p = mild();
+  const Image part = run_on(f, p, 0, roi).out;
+  const Image full = run_on(f, p).out;
+  const Image& in = f.image(Role::Colour);
+  for (int y = 0; y < 20; ++y)
+    for (int x = 0; x < 30; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const bool inside = x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1;
+        ASSERT_EQ(part.at(x, y, c), inside ? full.at(x, y, c) : in.at(x, y, c)) << x << "," << y;
+      }
+  EXPECT_GT(changed(full, in), 0.5);
+}
+
+// The kernel is built for several instruction sets; each must implement the same filter.
+TEST(BilateralFilterTest, EveryInstructionSetMatchesTheReference) {
+  Frame f = full_frame(37, 23, 21);
+  pass_image(f, Role::Normal).at(3, 9, 2) = kNaN;
+  pass_image(f, Role::Colour).at(30, 2, 1) = kInf;
+  const Params p = {{"spatial_sigma", 1.4}, {"use_depth", std::string("on")}, {"normal_sigma", 0.9},
+                    {"position_sigma", 1.2}, {"albedo_sigma", 0.6}};
+  const Params fov = with(p, {{"foveated", true}, {"spatial_sigma", 0.6}, {"spatial_sigma_outer", 2.0},
+                              {"colour_sigma_outer", 1.5}, {"inner_radius", 0.05}});
+  int ran = 0;
+  for (const char* isa : {"generic", "avx2", "avx512"}) {
+    if (!set_cross_filter_isa(isa)) continue;
+    SCOPED_TRACE(isa);
+    EXPECT_STREQ(cross_filter_isa(), isa);
+    expect_close(run_on(f, p).out, reference(f, p), 1e-4);
+    EXPECT_EQ(run_on(f, fov, 1).out.storage(), run_on(f, fov, 2).out.storage());
+    ++ran;
+  }
+  set_cross_filter_isa("");
+  EXPECT_GE(ran, 1);
+  EXPECT_FALSE(set_cross_filter_isa("neon512"));
+}
+
+TEST(BilateralFilterTest, TableAndPolicy) {
+  const FilterInfo& info = filter_info("bilateral");
+  for (const char* n : {"spatial_sigma", "spatial_sigma_outer", "radius", "use_colour", "colour_sigma",
+                        "colour_sigma_outer", "use_normal", "normal_sigma_outer", "use_position", "position_sigma",
+                        "use_albedo", "albedo_sigma", "use_depth", "depth_sigma_outer", "clamp", "foveated", "gaze_x",
+                        "gaze_y", "inner_radius", "outer_radius", "demodulate"}) {
+    bool found = false;
+    for (const ParamSpec& s : info.params) found = found || s.name == n;
+    EXPECT_TRUE(found) << n;
+  }
+  EXPECT_NE(info.nonfinite_policy.find("weight 0"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mcr
