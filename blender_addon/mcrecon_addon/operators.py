@@ -1,0 +1,103 @@
+"""Operators: mcrecon.denoise_files (re-denoise saved multilayer EXR sequences) and
+mcrecon.apply_passes (enable the chosen filter's passes, with a report)."""
+import os
+
+import bpy
+
+from . import native, pass_output, passes, properties, render_hooks
+
+
+_ITEMS = []  # Blender needs the strings of dynamic enum items kept alive
+
+
+def _filter_items(self, context):
+    if not _ITEMS:
+        _ITEMS.extend((i["name"], i["name"], i["summary"]) for i in native.get().filters())
+    return _ITEMS
+
+
+class MCRECON_OT_denoise_files(bpy.types.Operator):
+    """Denoise saved multilayer EXR renders (a #### sequence, in frame order, one temporal history)"""
+    bl_idname = "mcrecon.denoise_files"
+    bl_label = "Denoise EXR Files"
+    bl_options = {"REGISTER"}
+
+    filepath: bpy.props.StringProperty(name="Input", subtype="FILE_PATH",
+                                       description="Multilayer EXR, or a sequence pattern with ####")
+    output: bpy.props.StringProperty(name="Output", subtype="FILE_PATH", default="",
+                                     description="Output (with #### for sequences); empty: <input>_denoised.exr")
+    frame_start: bpy.props.IntProperty(name="Start", default=1)
+    frame_end: bpy.props.IntProperty(name="End", default=1)
+    filter: bpy.props.EnumProperty(name="Filter", items=_filter_items,
+                                   description="Filter (parameters from the scene's mcrecon settings)")
+
+    def invoke(self, context, event):
+        self.filter = context.scene.mcrecon.filter
+        self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        mc = native.get()
+        src = bpy.path.abspath(self.filepath)
+        out = bpy.path.abspath(self.output) if self.output else os.path.splitext(src)[0] + "_denoised.exr"
+        seq = "#" in src
+        frames = list(range(self.frame_start, self.frame_end + 1)) if seq else [None]
+        if seq and "#" not in out:
+            self.report({"ERROR"}, "mcrecon: the output must contain #### for a sequence input")
+            return {"CANCELLED"}
+        if not frames:
+            self.report({"ERROR"}, f"mcrecon: empty frame range {self.frame_start}-{self.frame_end}")
+            return {"CANCELLED"}
+        wm = context.window_manager
+        try:
+            session = mc.Session(self.filter, properties.filter_params(context.scene.mcrecon, self.filter))
+            jobs = [(render_hooks.frame_path(src, f) if seq else src, render_hooks.frame_path(out, f) if seq else out)
+                    for f in frames]
+            missing = [i for i, _ in jobs if not os.path.exists(i)]
+            if missing:
+                err = mc.Error(f"cannot read '{missing[0]}': no such file ({len(missing)} missing)")
+                err.kind = "file_not_found"
+                raise err
+            wm.progress_begin(0, len(jobs))
+            try:
+                for n, (i, o) in enumerate(jobs, 1):
+                    t = session.denoise_file(i, o)
+                    wm.progress_update(n)
+                    print(f"mcrecon: [{n}/{len(jobs)}] {o} ({t['total_ms']:.0f} ms)", flush=True)
+            finally:
+                wm.progress_end()
+        except mc.Error as e:
+            self.report({"ERROR"}, f"mcrecon: {e} [{e.kind}]")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"mcrecon: {len(jobs)} file(s) denoised with {self.filter}")
+        return {"FINISHED"}
+
+
+class MCRECON_OT_apply_passes(bpy.types.Operator):
+    """Enable exactly the passes the chosen mcrecon filter needs and turn Cycles' denoiser off"""
+    bl_idname = "mcrecon.apply_passes"
+    bl_label = "Set Passes for Filter"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        info = native.get().filter_info(context.scene.mcrecon.filter)
+        for m in passes.apply(context.scene, info):
+            self.report({"INFO"}, m)
+        if pass_output.ensure(context.scene, log=lambda m: self.report({"INFO"}, m)) is not None:
+            self.report({"INFO"}, "mcrecon: the output format is not MultiLayer: the 'mcrecon passes' "
+                                  "compositor node writes the passes")
+        return {"FINISHED"}
+
+
+_classes = (MCRECON_OT_denoise_files, MCRECON_OT_apply_passes)
+
+
+def register():
+    for c in _classes:
+        bpy.utils.register_class(c)
+
+
+def unregister():
+    for c in reversed(_classes):
+        bpy.utils.unregister_class(c)

@@ -1,0 +1,52 @@
+"""Which Blender pass toggles a filter's pass roles need, and switching them."""
+
+# Role (from the filter tables) -> (owner, attribute) on the view layer; owner "cycles" is
+# view_layer.cycles. Denoising Data gives Denoising Albedo / Normal / Depth at once.
+ROLE_TOGGLES = {
+    "albedo": ("cycles", "denoising_store_passes"),
+    "normal": ("", "use_pass_normal"),
+    "position": ("", "use_pass_position"),
+    "depth": ("", "use_pass_z"),
+    "motion": ("", "use_pass_vector"),
+}
+# Roles Blender always provides (Combined RGBA) and roles it cannot render.
+BUILTIN_ROLES = {"colour", "alpha"}
+
+
+def _owner(view_layer, owner):
+    return getattr(view_layer, owner) if owner else view_layer
+
+
+def wanted_toggles(info):
+    """(toggles to turn on, roles Blender cannot provide) for a filter description."""
+    roles = list(info["required_passes"]) + list(info["optional_passes"])
+    on = {ROLE_TOGGLES[r] for r in roles if r in ROLE_TOGGLES}
+    unavailable = [r for r in roles if r not in ROLE_TOGGLES and r not in BUILTIN_ROLES]
+    return on, unavailable
+
+
+def apply(scene, info, log=print):
+    """Enables exactly the passes the filter needs on every view layer of the scene and turns
+    Cycles' own denoiser off. Returns the messages it logged."""
+    messages = []
+    on, unavailable = wanted_toggles(info)
+    for vl in scene.view_layers:
+        for toggle in ROLE_TOGGLES.values():
+            owner = _owner(vl, toggle[0])
+            if owner is not None and hasattr(owner, toggle[1]):
+                setattr(owner, toggle[1], toggle in on)
+    names = sorted(("cycles." if o else "") + a for o, a in on)
+    messages.append(f"mcrecon: filter '{info['name']}' passes: combined"
+                    + (", " + ", ".join(names) if names else " only"))
+    if unavailable:
+        messages.append(f"mcrecon: Blender does not render {', '.join(unavailable)}; "
+                        f"'{info['name']}' runs without them")
+    if hasattr(scene, "cycles") and scene.cycles.use_denoising:
+        scene.cycles.use_denoising = False
+        messages.append("mcrecon: turned off Cycles denoising (scene.cycles.use_denoising); "
+                        "mcrecon denoises after the render")
+    if ("", "use_pass_vector") in on and scene.render.use_motion_blur:
+        messages.append("mcrecon: motion blur is on, so Blender drops the Vector (motion) pass")
+    for m in messages:
+        log(m)
+    return messages

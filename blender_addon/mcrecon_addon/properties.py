@@ -1,0 +1,123 @@
+"""scene.mcrecon: settings plus one PropertyGroup per filter, generated from the parameter
+tables of the native module (names, types, defaults, ranges, choices and help)."""
+import bpy
+
+from . import native, pass_output, passes
+
+INT32 = 2**31 - 1
+_classes = []          # registered classes, in order
+_prop_names = {}       # filter -> {parameter name: property name}
+RESERVED = {"name", "rna_type", "bl_rna"}
+
+
+def group_attr(filter_name):
+    return "params_" + filter_name
+
+
+def prop_name(param):
+    return "p_" + param if param in RESERVED else param
+
+
+def _property(spec):
+    t, desc = spec["type"], spec["help"]
+    if t == "int":
+        lo, hi = max(int(spec["min"]), -INT32), min(int(spec["max"]), INT32)
+        return bpy.props.IntProperty(name=spec["name"], description=desc, default=int(spec["default"]),
+                                     min=lo, max=hi)
+    if t == "float":
+        return bpy.props.FloatProperty(name=spec["name"], description=desc, default=float(spec["default"]),
+                                       min=float(spec["min"]), max=float(spec["max"]), precision=4)
+    if t == "bool":
+        return bpy.props.BoolProperty(name=spec["name"], description=desc, default=bool(spec["default"]))
+    if t == "enum":
+        items = [(c, c, desc) for c in spec["choices"]]
+        return bpy.props.EnumProperty(name=spec["name"], description=desc, items=items, default=spec["default"])
+    raise ValueError(f"parameter {spec['name']}: unknown type {t}")
+
+
+def _filter_group(info):
+    ann, names = {}, {}
+    for spec in info["parameters"]:
+        p = prop_name(spec["name"])
+        ann[p] = _property(spec)
+        names[spec["name"]] = p
+    _prop_names[info["name"]] = names
+    cls = type("MCRECON_PG_" + info["name"], (bpy.types.PropertyGroup,), {"__annotations__": ann})
+    cls.__doc__ = f"mcrecon '{info['name']}' parameters"
+    return cls
+
+
+def filter_params(settings, filter_name):
+    """The parameters of the filter that differ from their defaults, as a dict for the
+    native module (unchanged ones are left to the core, so float32 storage of a default never
+    matters), plus the key=value pairs of settings.extra_params."""
+    mc = native.get()
+    info = mc.filter_info(filter_name)
+    group = getattr(settings, group_attr(filter_name))
+    out = {}
+    for spec in info["parameters"]:
+        v = getattr(group, _prop_names[filter_name][spec["name"]])
+        d = spec["default"]
+        if spec["type"] == "float":
+            if abs(v - d) <= 1e-6 * max(1.0, abs(d)):
+                continue
+            v = min(max(float(v), spec["min"]), spec["max"])
+        elif v == d:
+            continue
+        out[spec["name"]] = v
+    for token in settings.extra_params.split():
+        key, eq, value = token.partition("=")
+        if not eq or not key:
+            err = mc.Error(f"extra parameters: expected KEY=VALUE, got '{token}'")
+            err.kind = "invalid_argument"
+            raise err
+        out[key] = value
+    return out
+
+
+def _on_filter_change(self, context):
+    if self.enabled:
+        passes.apply(context.scene, native.get().filter_info(self.filter))
+    pass_output.ensure(context.scene)
+
+
+def _base_annotations():
+    return {
+        "enabled": bpy.props.BoolProperty(
+            name="Denoise with mcrecon", default=False, update=_on_filter_change,
+            description="Run the mcrecon filter after every render (reads the passes from the multilayer EXR)"),
+        "output_path": bpy.props.StringProperty(
+            name="Output", subtype="FILE_PATH", default="",
+            description="Denoised output (#### = frame); empty: <render>_denoised.exr next to the render"),
+        "extra_params": bpy.props.StringProperty(
+            name="Extra parameters", default="",
+            description="Advanced: KEY=VALUE pairs passed to the filter as they are (like mcrecon denoise --set)"),
+        "last_message": bpy.props.StringProperty(name="Last message", default=""),
+    }
+
+
+def register():
+    infos = native.get().filters()
+    _classes.clear()
+    ann = _base_annotations()
+    for info in infos:
+        cls = _filter_group(info)
+        bpy.utils.register_class(cls)
+        _classes.append(cls)
+        ann[group_attr(info["name"])] = bpy.props.PointerProperty(type=cls)
+    ann["filter"] = bpy.props.EnumProperty(
+        name="Filter", items=[(i["name"], i["name"], i["summary"]) for i in infos],
+        default=infos[0]["name"], update=_on_filter_change,
+        description="mcrecon filter (Render properties show its parameters)")
+    settings = type("MCRECON_PG_settings", (bpy.types.PropertyGroup,), {"__annotations__": ann})
+    settings.__doc__ = "scene.mcrecon: mcrecon denoiser settings"
+    bpy.utils.register_class(settings)
+    _classes.append(settings)
+    bpy.types.Scene.mcrecon = bpy.props.PointerProperty(type=settings)
+
+
+def unregister():
+    del bpy.types.Scene.mcrecon
+    for cls in reversed(_classes):
+        bpy.utils.unregister_class(cls)
+    _classes.clear()

@@ -1,0 +1,181 @@
+"""After each render: read the passes from the multilayer EXR the render wrote, run the chosen
+filter (on the compositor's Combined when compositing is on, else the raw Combined), write the
+denoised EXR and load it as the image "mcrecon Result".
+
+One native Session per render job (render_init .. render_complete/render_cancel), so temporal
+filters (bmfr) see the frames of an animation in order, with their history. Errors become
+console messages and scene.mcrecon.last_message; they never stop Blender writing the render."""
+import os
+import re
+
+import bpy
+from bpy.app.handlers import persistent
+
+from . import native, pass_output, properties
+
+RESULT_IMAGE = "mcrecon Result"
+_job = {"session": None, "key": None}
+
+
+def log(scene, text, error=False):
+    line = ("mcrecon: ERROR: " if error else "mcrecon: ") + text
+    print(line, flush=True)
+    try:
+        scene.mcrecon.last_message = line
+    except Exception:  # read-only contexts (render thread of some builds)
+        pass
+
+
+def frame_path(pattern, frame):
+    """'#' runs become the zero-padded frame number."""
+    if "#" in pattern:
+        return re.sub(r"#+", lambda m: str(frame).zfill(len(m.group(0))), pattern)
+    return pattern
+
+
+def written_path(scene):
+    """The file the render just wrote. Stills (write_still) use render.filepath as it is (plus the
+    extension); animations substitute #### (or append the frame): take the newer of the two."""
+    r = scene.render
+    still = bpy.path.abspath(r.filepath)
+    ext = r.file_extension
+    if r.use_file_extension and not still.lower().endswith(ext.lower()):
+        still += ext
+    anim = r.frame_path(frame=scene.frame_current)
+    found = [p for p in (still, anim) if os.path.exists(p)]
+    if not found:
+        return anim
+    return max(found, key=os.path.getmtime)
+
+
+def output_for(scene, render_path):
+    mc = scene.mcrecon
+    if mc.output_path:
+        out = bpy.path.abspath(mc.output_path)
+        out = frame_path(out, scene.frame_current)  # animations: put #### in output_path
+        return out if out.lower().endswith(".exr") else out + ".exr"
+    stem, _ = os.path.splitext(render_path)
+    return stem + "_denoised.exr"
+
+
+def _compositing(scene):
+    r = scene.render
+    tree = scene.node_tree
+    return bool(r.use_compositing and scene.use_nodes and tree is not None
+                and any(n.bl_idname == "CompositorNodeComposite" for n in tree.nodes))
+
+
+def _session(scene):
+    """The job's Session, made on the first frame (parameter errors surface here)."""
+    mc = native.get()
+    settings = scene.mcrecon
+    params = properties.filter_params(settings, settings.filter)
+    key = (settings.filter, tuple(sorted((k, str(v)) for k, v in params.items())))
+    if _job["session"] is None or _job["key"] != key:
+        _job["session"] = mc.Session(settings.filter, params)
+        _job["key"] = key
+    return _job["session"]
+
+
+def _load_result(path):
+    def load():
+        img = bpy.data.images.get(RESULT_IMAGE)
+        if img is None:
+            img = bpy.data.images.load(path, check_existing=False)
+            img.name = RESULT_IMAGE
+        else:
+            img.filepath = path
+            img.reload()
+        return None
+    if bpy.app.background:
+        load()
+    else:  # handlers run in the render thread: touch bpy.data from the main loop
+        bpy.app.timers.register(load, first_interval=0.0)
+
+
+def denoise_render(scene, source, render_path):
+    """Denoises the multilayer EXR `source` (the render itself, or the add-on's pass file);
+    render_path names the default output. Returns the output path or None (error logged)."""
+    mc = native.get()
+    try:
+        if not os.path.exists(source):
+            log(scene, f"pass file '{source}' was not written", error=True)
+            return None
+        session = _session(scene)
+        out = output_for(scene, render_path)
+        layer = pass_output.view_layer(scene).name
+        passes = {}
+        if _compositing(scene):
+            passes = {"colour": "Composite.Combined"}
+        try:
+            t = session.denoise_file(source, out, layer=layer, passes=passes)
+        except mc.Error as e:
+            if not passes or e.kind != "missing_pass" or "Composite" not in str(e):
+                raise
+            log(scene, "no Composite.Combined in the render: denoising the raw Combined")
+            t = session.denoise_file(source, out, layer=layer)
+        log(scene, f"{session.filter} frame {scene.frame_current}: {out} "
+                   f"({t['filter_ms']:.0f} ms filter, {t['total_ms']:.0f} ms total)")
+        for note in session.notes:
+            log(scene, note)
+        _load_result(out)
+        return out
+    except mc.Error as e:
+        log(scene, f"{e} [{e.kind}]; the render itself is not affected ('{render_path}')", error=True)
+    except Exception as e:  # never let the add-on break a render
+        log(scene, f"{type(e).__name__}: {e}", error=True)
+    return None
+
+
+@persistent
+def on_render_init(scene, *args):
+    _job.update(session=None, key=None)
+    if getattr(scene, "mcrecon", None) is not None:
+        pass_output.ensure(scene)  # background / main thread; the UI sets it up on filter change
+
+
+@persistent
+def on_render_post(scene, *args):
+    # Not MultiLayer output (or F12 without a file): denoise the add-on's own pass file.
+    if not getattr(scene, "mcrecon", None) or not pass_output.needed(scene):
+        return
+    source = pass_output.file_for(scene, scene.frame_current)
+    if source is None:
+        log(scene, "the output format is not OpenEXR MultiLayer and the 'mcrecon passes' node is missing: "
+                   "press 'Set Passes for Filter' (or choose the filter again) before rendering", error=True)
+        return
+    denoise_render(scene, source, scene.render.frame_path(frame=scene.frame_current))
+
+
+@persistent
+def on_render_write(scene, *args):
+    if not getattr(scene, "mcrecon", None) or not scene.mcrecon.enabled or pass_output.needed(scene):
+        return
+    path = written_path(scene)
+    denoise_render(scene, path, path)
+
+
+@persistent
+def on_render_complete(scene, *args):
+    _job.update(session=None, key=None)
+
+
+_handlers = (
+    (bpy.app.handlers.render_init, on_render_init),
+    (bpy.app.handlers.render_post, on_render_post),
+    (bpy.app.handlers.render_write, on_render_write),
+    (bpy.app.handlers.render_complete, on_render_complete),
+    (bpy.app.handlers.render_cancel, on_render_complete),
+)
+
+
+def register():
+    for lst, fn in _handlers:
+        if fn not in lst:
+            lst.append(fn)
+
+
+def unregister():
+    for lst, fn in _handlers:
+        if fn in lst:
+            lst.remove(fn)

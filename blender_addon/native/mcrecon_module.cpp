@@ -1,0 +1,388 @@
+// mcrecon: the Python module (pybind11) over the core. Everything it shows of a
+// filter comes from the filter's one parameter table; every mcr::Error becomes
+// mcrecon.Error here, once (message + .kind). The GIL is released while filtering.
+#include <pybind11/functional.h>
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
+
+#include <cstring>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "filters/registry.h"
+#include "io/sequence.h"
+#include "pipeline/denoise_file.h"
+#include "util/error.h"
+
+namespace py = pybind11;
+
+namespace {
+
+using mcr::Errc;
+using mcr::Role;
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+using KeyValues = std::vector<std::pair<std::string, std::string>>;
+
+PyObject* g_error_type = nullptr;  // mcrecon.Error
+
+// ------------------------------------------------------------------ tables -> Python
+
+py::object value_to_py(const mcr::ParamValue& v) {
+  return std::visit([](const auto& x) -> py::object { return py::cast(x); }, v);
+}
+
+py::dict spec_to_dict(const mcr::ParamSpec& s) {
+  py::dict d;
+  d["name"] = s.name;
+  d["type"] = mcr::param_type_name(s.type);
+  d["default"] = value_to_py(s.default_value);
+  d["help"] = s.help;
+  if (s.type == mcr::ParamType::Int) {
+    d["min"] = std::int64_t(s.min);
+    d["max"] = std::int64_t(s.max);
+  }
+  if (s.type == mcr::ParamType::Float) {
+    d["min"] = s.min;
+    d["max"] = s.max;
+  }
+  if (s.type == mcr::ParamType::Enum) d["choices"] = s.choices;
+  return d;
+}
+
+py::dict info_to_dict(const mcr::FilterInfo& info) {
+  py::list params, req, opt;
+  for (const auto& s : info.params) params.append(spec_to_dict(s));
+  for (Role r : info.required) req.append(mcr::role_name(r));
+  for (Role r : info.optional) opt.append(mcr::role_name(r));
+  py::dict d;
+  d["name"] = info.name;
+  d["summary"] = info.summary;
+  d["reference"] = info.reference;
+  d["temporal"] = info.temporal;
+  d["required_passes"] = req;
+  d["optional_passes"] = opt;
+  d["nonfinite_policy"] = info.nonfinite_policy;
+  d["parameters"] = params;
+  return d;
+}
+
+// ------------------------------------------------------------------ Python -> core
+
+// Parameter values travel as text and are parsed by the table (set_text), so the
+// same rules hold as for `mcrecon denoise --set`.
+std::string py_to_text(const std::string& key, const py::handle& v) {
+  if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
+  if (py::isinstance<py::int_>(v)) return std::to_string(v.cast<long long>());
+  if (py::isinstance<py::float_>(v)) return py::str(py::repr(v)).cast<std::string>();  // round-trips
+  if (py::isinstance<py::str>(v)) return v.cast<std::string>();
+  if (py::hasattr(v, "dtype") && py::str(v.attr("dtype")).cast<std::string>() == "bool")  // numpy.bool_
+    return py::bool_(py::reinterpret_borrow<py::object>(v)).cast<bool>() ? "true" : "false";
+  if (py::hasattr(v, "__index__")) return std::to_string(py::int_(py::reinterpret_borrow<py::object>(v)).cast<long long>());  // numpy ints
+  if (py::hasattr(v, "__float__"))  // numpy floats
+    return py::str(py::repr(py::float_(py::reinterpret_borrow<py::object>(v)))).cast<std::string>();
+  throw mcr::Error(Errc::BadParameterValue, "parameter '" + key + "': expected bool, int, float or str, got " +
+                                                py::str(py::type::handle_of(v).attr("__name__")).cast<std::string>());
+}
+
+KeyValues params_from_dict(const py::dict& params) {
+  KeyValues kv;
+  for (const auto& item : params) {
+    const std::string key = py::str(item.first).cast<std::string>();
+    kv.emplace_back(key, py_to_text(key, item.second));
+  }
+  return kv;
+}
+
+std::vector<mcr::PassOverride> overrides_from_dict(const py::dict& passes) {
+  std::vector<mcr::PassOverride> out;
+  for (const auto& item : passes) {
+    const std::string role = py::str(item.first).cast<std::string>();
+    const std::string value = py::str(item.second).cast<std::string>();
+    out.push_back(mcr::parse_pass_override(role + "=" + value));
+  }
+  return out;
+}
+
+mcr::ReadOptions read_options(const std::optional<std::string>& layer, const py::dict& passes) {
+  mcr::ReadOptions ro;
+  if (layer) ro.layer = *layer;
+  ro.overrides = overrides_from_dict(passes);
+  return ro;
+}
+
+// One numpy pass (H x W or H x W x C) into the frame; checks size and channels.
+void add_array(mcr::Frame& frame, Role role, const py::object& obj, mcr::Space space) {
+  if (obj.is_none()) return;
+  FloatArray a = FloatArray::ensure(obj);
+  if (!a) throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": expected a float array");
+  if (a.ndim() != 2 && a.ndim() != 3)
+    throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": expected an H x W x C array, got " +
+                                                std::to_string(a.ndim()) + " dimensions");
+  const int h = int(a.shape(0)), w = int(a.shape(1)), c = a.ndim() == 3 ? int(a.shape(2)) : 1;
+  if (h <= 0 || w <= 0 || c <= 0) throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": empty array");
+  if (frame.passes.empty()) {
+    frame.width = w;
+    frame.height = h;
+  } else if (w != frame.width || h != frame.height) {
+    throw mcr::Error(Errc::SizeMismatch, std::string(mcr::role_name(role)) + " pass is " + std::to_string(w) + "x" +
+                                             std::to_string(h) + ", colour is " + std::to_string(frame.width) + "x" +
+                                             std::to_string(frame.height));
+  }
+  const int need = mcr::role_channels(role);
+  if (c < need)
+    throw mcr::Error(Errc::MissingPass, std::string(mcr::role_name(role)) + " pass has " + std::to_string(c) +
+                                            " channel(s), needs " + std::to_string(need));
+  mcr::Pass p;
+  p.role = role;
+  p.name = mcr::role_name(role);
+  p.source = frame.path;
+  p.space = space;
+  static const char* xyzw[] = {"X", "Y", "Z", "W"};
+  static const char* rgba[] = {"R", "G", "B", "A"};
+  for (int i = 0; i < c; ++i)
+    p.channels.push_back(p.name + "." + (i < 4 ? (role == Role::Colour || role == Role::Albedo ? rgba[i] : xyzw[i])
+                                              : std::to_string(i)));
+  p.image = mcr::Image(w, h, c);
+  std::memcpy(p.image.data(), a.data(), sizeof(float) * std::size_t(w) * std::size_t(h) * std::size_t(c));
+  frame.passes.push_back(std::move(p));
+}
+
+struct ArrayPasses {
+  py::object colour, albedo, normal, position, depth, motion, variance, sample_count, alpha;
+  std::string normal_space;
+};
+
+mcr::Space space_from(const std::string& s, const char* what) {
+  if (s == "world") return mcr::Space::World;
+  if (s == "camera") return mcr::Space::Camera;
+  if (s == "none") return mcr::Space::None;
+  throw mcr::Error(Errc::InvalidArgument, std::string(what) + ": space must be world, camera or none, got '" + s + "'");
+}
+
+mcr::Frame frame_from_arrays(const ArrayPasses& a) {
+  mcr::Frame f;
+  f.path = "<arrays>";
+  if (a.colour.is_none()) throw mcr::Error(Errc::MissingPass, "no colour array given");
+  add_array(f, Role::Colour, a.colour, mcr::Space::None);
+  add_array(f, Role::Albedo, a.albedo, mcr::Space::None);
+  add_array(f, Role::Normal, a.normal, space_from(a.normal_space, "normal_space"));
+  add_array(f, Role::Position, a.position, mcr::Space::World);
+  add_array(f, Role::Depth, a.depth, mcr::Space::Camera);
+  add_array(f, Role::Motion, a.motion, mcr::Space::None);
+  add_array(f, Role::Variance, a.variance, mcr::Space::None);
+  add_array(f, Role::SampleCount, a.sample_count, mcr::Space::None);
+  add_array(f, Role::Alpha, a.alpha, mcr::Space::None);
+  f.check_sizes();
+  return f;
+}
+
+mcr::ExecOptions exec_options(int threads, const std::optional<std::vector<int>>& roi) {
+  mcr::ExecOptions eo;
+  eo.nthreads = threads;
+  if (roi) {
+    if (roi->size() != 4) throw mcr::Error(Errc::InvalidArgument, "roi must be (x0, y0, x1, y1)");
+    eo.roi = {(*roi)[0], (*roi)[1], (*roi)[2], (*roi)[3]};
+  }
+  return eo;
+}
+
+py::array_t<float> to_numpy(mcr::Image img) {
+  auto* holder = new mcr::Image(std::move(img));
+  py::capsule owner(holder, [](void* p) { delete static_cast<mcr::Image*>(p); });
+  const py::ssize_t h = holder->height(), w = holder->width(), c = holder->channels();
+  return py::array_t<float>({h, w, c}, {w * c * py::ssize_t(sizeof(float)), c * py::ssize_t(sizeof(float)), py::ssize_t(sizeof(float))},
+                            holder->data(), owner);
+}
+
+py::dict times_dict(const mcr::StageTimes& t) {
+  py::dict d;
+  d["read_ms"] = t.read_ms;
+  d["filter_ms"] = t.filter_ms;
+  d["write_ms"] = t.write_ms;
+  d["total_ms"] = t.total_ms();
+  return d;
+}
+
+// ------------------------------------------------------------------ Session
+
+// One filter, committed once, with its temporal history kept across calls.
+class Session {
+ public:
+  Session(const std::string& filter, const py::dict& params, int threads)
+      : session_(filter, params_from_dict(params)), threads_(threads) {}
+
+  std::string name() { return session_.filter().info().name; }
+  bool temporal() { return session_.filter().info().temporal; }
+  py::dict params() {
+    py::dict d;
+    for (const auto& kv : session_.filter().params().values()) d[py::str(kv.first)] = value_to_py(kv.second);
+    return d;
+  }
+  std::vector<std::string> notes() { return session_.filter().notes(); }
+  void reset() { session_.filter().reset(); }
+
+  py::array_t<float> denoise(const ArrayPasses& a, const std::optional<std::vector<int>>& roi) {
+    const mcr::Frame frame = frame_from_arrays(a);
+    const mcr::ExecOptions eo = exec_options(threads_, roi);
+    mcr::Image out;
+    {
+      py::gil_scoped_release release;
+      out = session_.filter().execute(frame, eo);
+    }
+    return to_numpy(std::move(out));
+  }
+
+  py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,
+                        const py::dict& passes, bool keep_passes) {
+    const mcr::ReadOptions ro = read_options(layer, passes);
+    mcr::WriteOptions wo;
+    wo.keep_passes = keep_passes;
+    mcr::ReadOptions r = ro;
+    r.keep_extra = keep_passes;
+    const mcr::ExecOptions eo = exec_options(threads_, std::nullopt);
+    mcr::StageTimes t;
+    {
+      py::gil_scoped_release release;
+      t = session_.run(input, output, r, wo, eo);
+    }
+    return times_dict(t);
+  }
+
+ private:
+  mcr::DenoiseSession session_;
+  int threads_;
+};
+
+void raise_error(const mcr::Error& e) {
+  py::object exc = py::reinterpret_borrow<py::object>(g_error_type)(py::str(e.what()));
+  exc.attr("kind") = mcr::errc_name(e.code());
+  PyErr_SetObject(g_error_type, exc.ptr());
+}
+
+}  // namespace
+
+PYBIND11_MODULE(mcrecon, m) {
+  m.doc() = "mcrecon: reconstruct clean images from noisy Monte Carlo renders (filters from the mcrecon core)";
+  m.attr("__version__") = MCRECON_VERSION;
+
+  // mcrecon.Error(message) with .kind: "unknown_parameter", "missing_pass", ...
+  py::dict error_ns;
+  error_ns["kind"] = "internal";
+  error_ns["__doc__"] = "An mcrecon error: str(e) is the message (naming the filter, parameter, pass or file), "
+                        "e.kind the error kind (unknown_filter, unknown_parameter, parameter_out_of_range, "
+                        "bad_parameter_value, missing_pass, size_mismatch, file_not_found, ...).";
+  g_error_type = PyErr_NewException("mcrecon.Error", PyExc_RuntimeError, error_ns.ptr());
+  if (!g_error_type) throw py::error_already_set();
+  m.attr("Error") = py::reinterpret_borrow<py::object>(g_error_type);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const mcr::Error& e) {
+      raise_error(e);
+    }
+  });
+
+  m.def("filter_names", &mcr::filter_names, "Names of the registered filters, in registry order.");
+  m.def(
+      "filters",
+      [] {
+        py::list out;
+        for (const auto& n : mcr::filter_names()) out.append(info_to_dict(mcr::filter_info(n)));
+        return out;
+      },
+      "Every filter with its full parameter table (same content as `mcrecon filters --json`).");
+  m.def(
+      "filter_info", [](const std::string& name) { return info_to_dict(mcr::filter_info(name)); }, py::arg("name"),
+      "One filter's description and parameter table; raises mcrecon.Error for an unknown name.");
+
+  py::class_<Session>(m, "Session",
+                      "A committed filter that keeps temporal history across calls (one per shot / animation).")
+      .def(py::init<const std::string&, const py::dict&, int>(), py::arg("filter"), py::arg("params") = py::dict(),
+           py::arg("threads") = 0)
+      .def_property_readonly("filter", &Session::name)
+      .def_property_readonly("temporal", &Session::temporal)
+      .def_property_readonly("params", &Session::params, "every parameter value (defaults filled in)")
+      .def_property_readonly("notes", &Session::notes, "notes from the last run")
+      .def("reset", &Session::reset, "drop temporal history (new shot)")
+      .def(
+          "denoise",
+          [](Session& s, py::object colour, py::object albedo, py::object normal, py::object position, py::object depth,
+             py::object motion, py::object variance, py::object sample_count, py::object alpha,
+             const std::string& normal_space, const std::optional<std::vector<int>>& roi) {
+            return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
+                             roi);
+          },
+          py::arg("colour"), py::arg("albedo") = py::none(), py::arg("normal") = py::none(),
+          py::arg("position") = py::none(), py::arg("depth") = py::none(), py::arg("motion") = py::none(),
+          py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
+          py::arg("normal_space") = "world", py::arg("roi") = py::none(),
+          "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32.")
+      .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
+           py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
+           "Reads a render (multilayer EXR), filters it and writes output (temp + rename); returns stage timings. "
+           "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}.");
+
+  m.def(
+      "denoise",
+      [](const std::string& filter, py::object colour, py::object albedo, py::object normal, py::object position,
+         py::object depth, py::object motion, py::object variance, py::object sample_count, py::object alpha,
+         const std::string& normal_space, const py::dict& params, int threads, const std::optional<std::vector<int>>& roi) {
+        Session s(filter, params, threads);
+        return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
+                         roi);
+      },
+      py::arg("filter"), py::arg("colour"), py::arg("albedo") = py::none(), py::arg("normal") = py::none(),
+      py::arg("position") = py::none(), py::arg("depth") = py::none(), py::arg("motion") = py::none(),
+      py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
+      py::arg("normal_space") = "world", py::arg("params") = py::dict(), py::arg("threads") = 0,
+      py::arg("roi") = py::none(),
+      "Filters one frame given as float32 H x W x C numpy arrays (colour RGB or RGBA, features as available); "
+      "returns H x W x 3 float32.");
+
+  m.def(
+      "denoise_file",
+      [](const std::string& input, const std::string& output, const std::string& filter, const py::dict& params,
+         const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads) {
+        Session s(filter, params, threads);
+        return s.denoise_file(input, output, layer, passes, keep_passes);
+      },
+      py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
+      py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
+      py::arg("threads") = 0, "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...`.");
+
+  m.def(
+      "denoise_sequence",
+      [](const std::string& input, const std::string& output, int first, int last, const std::string& filter,
+         const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
+         const std::optional<std::function<void(int, int, std::string)>>& progress) {
+        if (!mcr::is_sequence_pattern(input) || !mcr::is_sequence_pattern(output))
+          throw mcr::Error(Errc::InvalidArgument, "input and output must be sequence patterns (#### or %04d)");
+        if (last < first) throw mcr::Error(Errc::InvalidArgument, "frame range " + std::to_string(first) + "-" +
+                                                                        std::to_string(last) + " is empty");
+        for (int f = first; f <= last; ++f) {  // every input checked before the first is filtered
+          const std::string in = mcr::sequence_path(input, f);
+          std::error_code ec;
+          if (!std::filesystem::exists(in, ec))
+            throw mcr::Error(Errc::FileNotFound, "cannot read '" + in + "': no such file");
+        }
+        Session s(filter, params, threads);
+        py::list outputs;
+        for (int f = first; f <= last; ++f) {
+          const std::string out = mcr::sequence_path(output, f);
+          s.denoise_file(mcr::sequence_path(input, f), out, layer, passes, false);
+          outputs.append(out);
+          if (progress) (*progress)(f - first + 1, last - first + 1, out);
+        }
+        return outputs;
+      },
+      py::arg("input"), py::arg("output"), py::arg("first"), py::arg("last"), py::arg("filter"),
+      py::arg("params") = py::dict(), py::arg("layer") = py::none(), py::arg("passes") = py::dict(),
+      py::arg("threads") = 0, py::arg("progress") = py::none(),
+      "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history); "
+      "progress(done, total, output) is called after each frame. Returns the outputs written.");
+}

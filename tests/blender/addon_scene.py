@@ -1,0 +1,214 @@
+"""Runs inside Blender (headless) for tests/blender/blender_case.py:
+
+    blender -b --factory-startup --python-exit-code 1 --python addon_scene.py -- CASE OUT_DIR
+
+Builds the sample room (samples/scenes) at a tiny size, enables the add-on from the staged
+package ($MCRECON_ADDON_STAGE, or installs $MCRECON_ADDON_ZIP for the install_zip case), does
+what CASE asks and writes OUT_DIR/result.json with what it saw; the driver checks it.
+"""
+import json
+import os
+import sys
+import time
+
+import addon_utils
+import bpy
+
+CASE, OUT = sys.argv[sys.argv.index("--") + 1:][:2]
+SRC = os.environ["MCRECON_SOURCE_DIR"]
+sys.path.insert(0, os.path.join(SRC, "samples", "scenes"))
+import common as C  # noqa: E402
+
+W, H = 64, 48
+result = {"case": CASE}
+
+
+def enable_addon():
+    if CASE == "install_zip":
+        bpy.ops.preferences.addon_install(filepath=os.environ["MCRECON_ADDON_ZIP"], overwrite=True)
+        bpy.ops.preferences.addon_enable(module="mcrecon_addon")
+        mod = sys.modules.get("mcrecon_addon")
+    else:
+        sys.path.insert(0, os.environ["MCRECON_ADDON_STAGE"])
+        mod = addon_utils.enable("mcrecon_addon", default_set=True, handle_error=None)
+    assert mod is not None, "the add-on did not enable"
+    result["addon_file"] = mod.__file__
+    return mod
+
+
+def room_scene():
+    import room
+    scene = room.build()
+    vl = C.configure_render(scene, W, H)
+    C.set_passes(vl, False)  # the add-on chooses the passes
+    scene.cycles.use_denoising = True  # the add-on must turn this off
+    return scene
+
+
+def written(scene):
+    from mcrecon_addon import render_hooks
+    return render_hooks.written_path(scene)
+
+
+def render(scene, path, spp, seed, animation=False):
+    scene.cycles.samples = spp
+    scene.cycles.seed = seed
+    scene.render.filepath = path
+    t0 = time.time()
+    if animation:
+        bpy.ops.render.render(animation=True)
+    else:
+        bpy.ops.render.render(write_still=True)
+    return time.time() - t0
+
+
+def toggles(scene):
+    vl = scene.view_layers[0]
+    return {"use_pass_normal": vl.use_pass_normal, "use_pass_position": vl.use_pass_position,
+            "use_pass_z": vl.use_pass_z, "use_pass_vector": vl.use_pass_vector,
+            "cycles.denoising_store_passes": vl.cycles.denoising_store_passes}
+
+
+def case_render(filter_name):
+    scene = room_scene()
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = filter_name
+    result["cycles_denoising"] = scene.cycles.use_denoising
+    result["noisy_seconds"] = render(scene, os.path.join(OUT, "noisy"), 16, 11)
+    result["noisy"] = written(scene)
+    result["message"] = mc.last_message
+    img = bpy.data.images.get("mcrecon Result")
+    result["result_image"] = img.filepath if img else None
+    mc.enabled = False  # reference: same scene, many samples, no denoising
+    result["ref_seconds"] = render(scene, os.path.join(OUT, "ref"), 256, 12345)
+    result["ref"] = written(scene)
+
+
+def case_passes():
+    scene = room_scene()
+    import mcrecon_addon.native as native
+    import mcrecon_addon.passes as passes
+    mc = scene.mcrecon
+    mc.enabled = True
+    result["cycles_denoising"] = scene.cycles.use_denoising
+    seen = {}
+    for info in native.get().filters():
+        mc.filter = info["name"]
+        group = getattr(mc, "params_" + info["name"])
+        defaults_ok = all(
+            (abs(getattr(group, s["name"]) - s["default"]) <= 1e-6 * max(1, abs(s["default"])))
+            if s["type"] == "float" else getattr(group, s["name"]) == s["default"]
+            for s in info["parameters"])
+        seen[info["name"]] = {"toggles": toggles(scene), "defaults_ok": defaults_ok,
+                              "roles": info["required_passes"] + info["optional_passes"]}
+    result["filters"] = seen
+    # The panel draws every parameter of the chosen filter (recorded by a stand-in layout).
+    drawn = []
+
+    class Layout:
+        def __getattr__(self, name):
+            if name == "prop":
+                return lambda data, prop, **kw: drawn.append(prop)
+            return lambda *a, **kw: Layout()
+
+        def __setattr__(self, name, value):
+            pass
+
+    class Panel:
+        layout = Layout()
+    for name in ("box", "bilateral"):
+        mc.filter = name
+        drawn.clear()
+        bpy.types.MCRECON_PT_render.draw(Panel(), bpy.context)
+        result.setdefault("panel", {})[name] = list(drawn)
+    result["role_toggles"] = {r: (o + "." if o else "") + a for r, (o, a) in passes.ROLE_TOGGLES.items()}
+    # The operator does the same and reports.
+    mc.filter = "box"
+    bpy.ops.mcrecon.apply_passes()
+    result["after_operator_box"] = toggles(scene)
+
+
+def case_anim():
+    import anim
+    scene = anim.build()
+    vl = C.configure_render(scene, W, H)
+    C.set_passes(vl, False)
+    scene.frame_start, scene.frame_end = 1, 4
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = "bmfr"
+    mc.output_path = os.path.join(OUT, "den_####.exr")
+    result["anim_seconds"] = render(scene, os.path.join(OUT, "anim_####"), 4, 7, animation=True)
+    result["renders"] = [scene.render.frame_path(frame=f) for f in range(1, 5)]
+    result["outputs"] = [os.path.join(OUT, "den_%04d.exr" % f) for f in range(1, 5)]
+    result["message"] = mc.last_message
+    # Re-denoise the saved sequence with the operator.
+    mc.enabled = False
+    r = bpy.ops.mcrecon.denoise_files(filepath=os.path.join(OUT, "anim_####.exr"),
+                                      output=os.path.join(OUT, "redo_####.exr"),
+                                      frame_start=1, frame_end=4, filter="bmfr")
+    result["operator"] = sorted(r)
+    result["redo"] = [os.path.join(OUT, "redo_%04d.exr" % f) for f in range(1, 5)]
+
+
+def case_errors():
+    scene = room_scene()
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = "box"
+    mc.extra_params = "no_such_param=3"
+    render(scene, os.path.join(OUT, "badparam"), 2, 1)
+    result["badparam_render"] = written(scene)
+    result["badparam_message"] = mc.last_message
+    mc.extra_params = ""
+    mc.filter = "bmfr"
+    scene.view_layers[0].use_pass_position = False  # bmfr cannot run without it
+    scene.view_layers[0].use_pass_normal = False
+    render(scene, os.path.join(OUT, "nopass"), 2, 1)
+    result["nopass_render"] = written(scene)
+    result["nopass_message"] = mc.last_message
+    # PNG output: the add-on writes the passes itself (File Output node) and still denoises.
+    scene.render.image_settings.file_format = "PNG"
+    mc.filter = "bilateral"
+    render(scene, os.path.join(OUT, "png"), 2, 1)
+    result["png_render"] = written(scene)
+    result["png_message"] = mc.last_message
+    result["png_expected"] = os.path.join(OUT, "png%04d_denoised.exr" % scene.frame_current)
+
+
+def case_composite():
+    scene = room_scene()
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = "box"
+    scene.use_nodes = True
+    scene.render.use_compositing = True
+    tree = scene.node_tree
+    for n in list(tree.nodes):
+        tree.nodes.remove(n)
+    rl = tree.nodes.new("CompositorNodeRLayers")
+    inv = tree.nodes.new("CompositorNodeInvert")
+    comp = tree.nodes.new("CompositorNodeComposite")
+    tree.links.new(rl.outputs["Image"], inv.inputs["Color"])
+    tree.links.new(inv.outputs["Color"], comp.inputs["Image"])
+    render(scene, os.path.join(OUT, "comp"), 4, 3)
+    result["render"] = written(scene)
+    result["message"] = mc.last_message
+
+
+def case_install_zip():
+    scene = bpy.context.scene
+    import mcrecon_addon.native as native
+    result["filters"] = native.get().filter_names()
+    result["native_file"] = native.get().__file__
+    result["has_settings"] = hasattr(scene, "mcrecon")
+    result["panel"] = hasattr(bpy.types, "MCRECON_PT_render")
+
+
+enable_addon()
+{"render_box": lambda: case_render("box"), "render_bilateral": lambda: case_render("bilateral"),
+ "passes": case_passes, "anim_bmfr": case_anim, "errors": case_errors,
+ "composite": case_composite, "install_zip": case_install_zip}[CASE]()
+with open(os.path.join(OUT, "result.json"), "w") as f:
+    json.dump(result, f, indent=1)

@@ -1,0 +1,175 @@
+"""Driver of the Blender add-on tests (ctest blender_addon_CASE): runs real Blender headless on
+addon_scene.py, then checks exit status, files, console messages and image error.
+
+    /usr/bin/python3 blender_case.py CASE      (render_box, render_bilateral, passes, anim_bmfr,
+                                                errors, composite, install_zip)
+Environment: MCRECON_BLENDER, MCRECON_SOURCE_DIR, MCRECON_ADDON_STAGE, MCRECON_ADDON_ZIP,
+MCRECON_TEST_TMP. Exit 77 = skipped (ctest SKIP_RETURN_CODE).
+"""
+import json
+import os
+import shutil
+import subprocess
+import sys
+import time
+
+import numpy as np
+import OpenImageIO as oiio
+
+CASE = sys.argv[1]
+HERE = os.path.dirname(os.path.abspath(__file__))
+STAGE = os.environ["MCRECON_ADDON_STAGE"]
+OUT = os.path.join(os.environ["MCRECON_TEST_TMP"], CASE)
+sys.path.insert(0, os.path.join(STAGE, "mcrecon_addon"))
+import mcrecon  # noqa: E402  (the module bundled in the add-on package)
+
+
+def skip(why):
+    print("SKIPPED:", why)
+    sys.exit(77)
+
+
+def run_blender(env_extra=None):
+    shutil.rmtree(OUT, ignore_errors=True)
+    os.makedirs(OUT)
+    env = dict(os.environ)
+    # Never touch the user's Blender configuration.
+    env["BLENDER_USER_CONFIG"] = os.path.join(OUT, "config")
+    env["BLENDER_USER_SCRIPTS"] = os.path.join(OUT, "scripts")
+    env.update(env_extra or {})
+    cmd = [os.environ["MCRECON_BLENDER"], "-b", "--factory-startup", "--python-exit-code", "1",
+           "--python", os.path.join(HERE, "addon_scene.py"), "--", CASE, OUT]
+    t0 = time.time()
+    p = subprocess.run(cmd, capture_output=True, text=True, timeout=200, env=env)
+    seconds = time.time() - t0
+    log = p.stdout + p.stderr
+    with open(os.path.join(OUT, "blender.log"), "w") as f:
+        f.write(log)
+    print(f"blender {CASE}: exit {p.returncode} in {seconds:.1f} s")
+    if p.returncode != 0:
+        print(log[-6000:])
+    assert p.returncode == 0, f"Blender exited {p.returncode}"
+    assert "Traceback" not in log, "a Python traceback appeared in the console:\n" + log[-4000:]
+    with open(os.path.join(OUT, "result.json")) as f:
+        return json.load(f), log
+
+
+def rgb(path):
+    inp = oiio.ImageInput.open(path)
+    assert inp, f"cannot open {path}: {oiio.geterror()}"
+    names = list(inp.spec().channelnames)
+    px = inp.read_image(0, 0, 0, len(names), "float")
+    inp.close()
+    for prefix in ("", "ViewLayer.Combined.", "Composite.Combined."):
+        if all(prefix + c in names for c in "RGB"):
+            return px[:, :, [names.index(prefix + c) for c in "RGB"]].astype(np.float64)
+    raise AssertionError(f"{path}: no RGB channels in {names}")
+
+
+def relmse(x, ref):
+    return float(np.mean((x - ref) ** 2 / (ref ** 2 + 1e-2)))
+
+
+def check_render(filter_name):
+    if filter_name not in mcrecon.filter_names():
+        skip(f"filter '{filter_name}' is not registered")
+    r, log = run_blender()
+    assert r["cycles_denoising"] is False, "the add-on did not turn Cycles denoising off"
+    assert "turned off Cycles denoising" in log
+    noisy, ref = r["noisy"], r["ref"]
+    den = os.path.splitext(noisy)[0] + "_denoised.exr"
+    for p in (noisy, ref, den):
+        assert os.path.exists(p), f"missing {p}\n{log[-3000:]}"
+    assert r["result_image"] and os.path.samefile(r["result_image"], den), r["result_image"]
+    e_noisy, e_den = relmse(rgb(noisy), rgb(ref)), relmse(rgb(den), rgb(ref))
+    print(f"{filter_name}: relMSE noisy {e_noisy:.5f}, denoised {e_den:.5f} "
+          f"(render 16 spp {r['noisy_seconds']:.1f} s, reference 256 spp {r['ref_seconds']:.1f} s)")
+    assert e_den < e_noisy, "the denoised render is not closer to the reference than the noisy one"
+
+
+def check_passes():
+    r, log = run_blender()
+    assert r["cycles_denoising"] is False
+    role_toggles = r["role_toggles"]
+    for name, f in r["filters"].items():
+        want = {role_toggles[x] for x in f["roles"] if x in role_toggles}
+        on = {k for k, v in f["toggles"].items() if v}
+        assert on == want, f"{name}: passes on {sorted(on)}, needs {sorted(want)}"
+        assert f["defaults_ok"], f"{name}: a generated property's default differs from the table"
+        print(f"{name}: {sorted(on) or 'combined only'}")
+    assert not any(r["filters"]["box"]["toggles"].values()), "box needs no feature pass"
+    if "bilateral" in r["filters"]:
+        t = r["filters"]["bilateral"]["toggles"]
+        assert t["use_pass_normal"] and t["use_pass_position"] and t["use_pass_z"] \
+            and t["cycles.denoising_store_passes"] and not t["use_pass_vector"], t
+    assert not any(r["after_operator_box"].values())
+    for name, drawn in r["panel"].items():
+        params = [p["name"] for p in mcrecon.filter_info(name)["parameters"]]
+        assert all(p in drawn for p in params), f"panel for {name} lacks {set(params) - set(drawn)}"
+        assert "filter" in drawn and "output_path" in drawn
+    print("panel draws the chosen filter's parameters")
+
+
+def check_anim():
+    if "bmfr" not in mcrecon.filter_names():
+        skip("filter 'bmfr' is not registered")
+    r, log = run_blender()
+    for p in r["renders"] + r["outputs"] + r["redo"]:
+        assert os.path.exists(p), f"missing {p}\n{log[-3000:]}"
+    assert r["operator"] == ["FINISHED"], r["operator"]
+    assert "ERROR" not in r["message"], r["message"]
+    assert log.count("mcrecon: bmfr frame") == 4, log[-3000:]
+    assert "[4/4]" in log
+    # Same frames, same filter, one history each: the operator reproduces the render-time outputs.
+    for a, b in zip(r["outputs"], r["redo"]):
+        assert np.array_equal(rgb(a), rgb(b)), f"{a} and {b} differ"
+    print(f"bmfr: 4 frames rendered and denoised in {r['anim_seconds']:.1f} s; operator matches")
+
+
+def check_errors():
+    r, log = run_blender()
+    for key, words in (("badparam", ["no_such_param"]), ("nopass", ["position"])):
+        assert os.path.exists(r[key + "_render"]), f"the render was not written: {r[key + '_render']}"
+        msg = r[key + "_message"]
+        assert msg.startswith("mcrecon: ERROR"), f"{key}: {msg}"
+        for w in words:
+            assert w in msg, f"{key}: message {msg!r} does not name {w!r}"
+        assert msg in log, f"{key}: message not on the console"
+        print(f"{key}: {msg}")
+    assert not os.path.exists(os.path.splitext(r["badparam_render"])[0] + "_denoised.exr")
+    # PNG output: rendered as PNG, denoised from the add-on's own pass file.
+    assert r["png_render"].endswith(".png") and os.path.exists(r["png_render"]), r["png_render"]
+    assert "ERROR" not in r["png_message"] and os.path.exists(r["png_expected"]), r["png_message"]
+    assert "Traceback" not in log
+    print(f"png: {r['png_message']}")
+
+
+def check_composite():
+    r, log = run_blender()
+    den = os.path.splitext(r["render"])[0] + "_denoised.exr"
+    assert os.path.exists(den), r["message"]
+    assert "ERROR" not in r["message"], r["message"]
+    inp = oiio.ImageInput.open(r["render"])
+    names = list(inp.spec().channelnames)
+    px = inp.read_image(0, 0, 0, len(names), "float")
+    inp.close()
+    comp = px[:, :, [names.index("Composite.Combined." + c) for c in "RGB"]].mean()
+    raw = px[:, :, [names.index("ViewLayer.Combined." + c) for c in "RGB"]].mean()
+    got = rgb(den).mean()
+    print(f"composite: mean of Composite.Combined {comp:.4f}, raw Combined {raw:.4f}, denoised {got:.4f}")
+    assert abs(got - comp) < 0.05 * max(1.0, abs(comp)) and abs(got - raw) > 0.1, "did not denoise the composite"
+
+
+def check_install_zip():
+    r, log = run_blender()
+    assert r["has_settings"] and r["panel"]
+    assert r["filters"] == mcrecon.filter_names()
+    scripts = os.path.join(OUT, "scripts")
+    assert os.path.realpath(r["native_file"]).startswith(os.path.realpath(scripts)), r["native_file"]
+    print(f"installed from the zip into {scripts}; native module {os.path.basename(r['native_file'])}")
+
+
+{"render_box": lambda: check_render("box"), "render_bilateral": lambda: check_render("bilateral"),
+ "passes": check_passes, "anim_bmfr": check_anim, "errors": check_errors,
+ "composite": check_composite, "install_zip": check_install_zip}[CASE]()
+print("OK")
