@@ -90,7 +90,21 @@ class MCRECON_OT_apply_passes(bpy.types.Operator):
         return {"FINISHED"}
 
 
-_classes = (MCRECON_OT_denoise_files, MCRECON_OT_apply_passes)
+class MCRECON_OT_report(bpy.types.Operator):
+    """Turns a message from a render handler into a Blender report (Info editor, status bar)."""
+    bl_idname = "mcrecon.report"
+    bl_label = "mcrecon report"
+    bl_options = {'INTERNAL'}
+
+    message: bpy.props.StringProperty()
+    level: bpy.props.EnumProperty(items=[('INFO', "Info", ""), ('WARNING', "Warning", ""), ('ERROR', "Error", "")])
+
+    def execute(self, context):
+        self.report({self.level}, self.message)
+        return {'FINISHED'}
+
+
+_classes = (MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_report)
 
 
 def register():

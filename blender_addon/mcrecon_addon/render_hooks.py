@@ -24,6 +24,12 @@ def log(scene, text, error=False):
         scene.mcrecon.last_message = line
     except Exception:  # read-only contexts (render thread of some builds)
         pass
+    if error:
+        # Also a real Blender report, so it shows in the Info editor and status bar.
+        try:
+            bpy.ops.mcrecon.report(message=text, level='ERROR')
+        except Exception:  # no operator context in this handler: the console line stands
+            pass
 
 
 def frame_path(pattern, frame):
