@@ -7,7 +7,8 @@
 // Speed: the `anim` frames (1 spp) upscaled bilinearly x8 to 1280x720 (motion vectors x8),
 // run as a sequence; per-stage and total milliseconds per frame, best of `repeat` passes
 // over the sequence (each pass after a reset, first frame of each pass excluded: it has no
-// history). Beside it, the time to read the same multi-pass frame from an EXR and write the
+// history), wall and process CPU time (all threads; the stage CPU times come from
+// BmfrFilter::stage_cpu_ms()): on a shared machine the CPU columns are the steadier ones. Beside it, the time to read the same multi-pass frame from an EXR and write the
 // RGBA result (the I/O floor a file pipeline pays anyway). The machine is shared: the load
 // average is printed before and after.
 // Quality: mean relMSE / SSIM over frames 9-16 (second half) and temporal error over the
@@ -163,7 +164,8 @@ void quality(int threads) {
       std::string label;
       std::vector<std::pair<std::string, std::string>> params;
     };
-    std::vector<Config> configs = {{"bmfr (defaults: 32, default, taa)", {}},
+    std::vector<Config> configs = {{"bmfr (defaults: auto block, taa)", {}},
+                                   {"bmfr block_size=32", {{"block_size", "32"}}},
                                    {"bmfr block_size=16", {{"block_size", "16"}}},
                                    {"bmfr block_size=64", {{"block_size", "64"}}},
                                    {"bmfr features=first_order", {{"features", "first_order"}}},
@@ -258,12 +260,14 @@ void speed(int threads, int repeat, int nframes) {
   for (int i = 0; i < nframes && i < int(scene.frames.size()); ++i) frames.push_back(upscale_frame(scene.frames[std::size_t(i)], 8));
   std::printf("\nspeed: %dx%d (anim 1 spp upscaled x8), %zu frames, %d threads, best of %d passes; load before: %s\n",
               frames[0].width, frames[0].height, frames.size(), threads, repeat, loadavg().c_str());
-  std::printf("  %-32s %8s %8s %8s %8s %8s %9s\n", "config", "phaseI", "fit", "phaseIII", "taa", "total", "cpu/frame");
+  std::printf("  wall ms per frame (best pass), then process CPU ms (all threads) per stage and per frame\n");
+  std::printf("  %-28s %7s %7s %7s %7s %7s | %6s %6s %6s %6s %9s\n", "config", "phaseI", "fit", "phIII", "taa", "total", "cI",
+              "cfit", "cIII", "ctaa", "cpu/frame");
   struct Config {
     std::string label;
     std::vector<std::pair<std::string, std::string>> params;
   };
-  const std::vector<Config> configs = {{"block_size=32 default", {}},
+  const std::vector<Config> configs = {{"default (auto = 32 at 720p)", {}},
                                        {"block_size=16", {{"block_size", "16"}}},
                                        {"block_size=64", {{"block_size", "64"}}},
                                        {"features=first_order", {{"features", "first_order"}}},
@@ -275,10 +279,10 @@ void speed(int threads, int repeat, int nframes) {
     for (const auto& kv : c.params) f->set_text(kv.first, kv.second);
     f->commit();
     auto* b = dynamic_cast<BmfrFilter*>(f.get());
-    double best[5] = {1e30, 1e30, 1e30, 1e30, 1e30}, best_cpu = 1e30;
+    double best[5] = {1e30, 1e30, 1e30, 1e30, 1e30}, best_cpu = 1e30, best_scpu[4] = {1e30, 1e30, 1e30, 1e30};
     for (int r = 0; r < repeat; ++r) {
       f->reset();
-      double sum[5] = {0, 0, 0, 0, 0};
+      double sum[5] = {0, 0, 0, 0, 0}, scpu[4] = {0, 0, 0, 0};
       int counted = 0;
       double cpu = 0;
       for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -289,13 +293,16 @@ void speed(int threads, int repeat, int nframes) {
         if (i == 0) continue;
         cpu += cpu_ms() - c0;
         for (int s = 0; s < 4; ++s) sum[s] += b->stage_ms()[std::size_t(s)];
+        for (int s = 0; s < 4; ++s) scpu[s] += b->stage_cpu_ms()[std::size_t(s)];
         sum[4] += total;
         ++counted;
       }
       for (int s = 0; s < 5; ++s) best[s] = std::min(best[s], sum[s] / std::max(1, counted));
       best_cpu = std::min(best_cpu, cpu / std::max(1, counted));
+      for (int s = 0; s < 4; ++s) best_scpu[s] = std::min(best_scpu[s], scpu[s] / std::max(1, counted));
     }
-    std::printf("  %-32s %8.2f %8.2f %8.2f %8.2f %8.2f %9.2f\n", c.label.c_str(), best[0], best[1], best[2], best[3], best[4], best_cpu);
+    std::printf("  %-28s %7.2f %7.2f %7.2f %7.2f %7.2f | %6.2f %6.2f %6.2f %6.2f %9.2f\n", c.label.c_str(), best[0], best[1],
+                best[2], best[3], best[4], best_scpu[0], best_scpu[1], best_scpu[2], best_scpu[3], best_cpu);
   }
   // I/O floor: read the multi-pass frame, write the RGBA result.
   const std::string dir = (std::filesystem::temp_directory_path() / "mcrecon_bench_bmfr").string();

@@ -3,17 +3,27 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <limits>
+#include <ctime>
 
 #include "linalg/householder_qr.h"
 #include "util/error.h"
 #include "util/parallel.h"
+
+#include <tbb/enumerable_thread_specific.h>
 
 namespace mcr {
 
 namespace {
 
 constexpr double kFloatMax = std::numeric_limits<float>::max();
+
+double cpu_now_ms() {
+  timespec t;
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return double(t.tv_sec) * 1e3 + double(t.tv_nsec) * 1e-6;
+}
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
@@ -27,7 +37,6 @@ std::uint64_t splitmix(std::uint64_t& s) {
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
 }
-double uniform_pm1(std::uint64_t& s) { return double(splitmix(s) >> 11) * (2.0 / 9007199254740992.0) - 1.0; }
 
 // Raw (unscaled) feature channels per feature set. The fitted columns are then
 // [1, raw scaled to [-1,1] ..., squares of the scaled positions rescaled to [-1,1]].
@@ -53,7 +62,7 @@ FeatureLayout layout_of(const std::string& set) {
 bool catmull_rom(const Image& im, float x, float y, float* out) {
   const int w = im.width(), h = im.height();
   if (!(x >= -0.5f && y >= -0.5f && x <= float(w) - 0.5f && y <= float(h) - 0.5f)) return false;
-  const float fx0 = std::floor(x), fy0 = std::floor(y);
+  const float fx0 = float(floor_int(x)), fy0 = float(floor_int(y));
   const float tx = x - fx0, ty = y - fy0;
   auto weights = [](float t, float* wt) {
     const float t2 = t * t, t3 = t2 * t;
@@ -65,17 +74,29 @@ bool catmull_rom(const Image& im, float x, float y, float* out) {
   float wx[4], wy[4];
   weights(tx, wx);
   weights(ty, wy);
-  double acc[3] = {0, 0, 0};
-  for (int j = 0; j < 4; ++j) {
-    const int yy = std::clamp(int(fy0) - 1 + j, 0, h - 1);
-    for (int i = 0; i < 4; ++i) {
-      const int xx = std::clamp(int(fx0) - 1 + i, 0, w - 1);
-      const float* p = im.pixel(xx, yy);
-      const double wgt = double(wx[i]) * wy[j];
-      for (int c = 0; c < 3; ++c) acc[c] += wgt * p[c];
+  float acc[3] = {0, 0, 0};
+  const int bx = int(fx0) - 1, by = int(fy0) - 1;
+  if (bx >= 0 && by >= 0 && bx + 3 < w && by + 3 < h) {  // interior: no clamping
+    const float* base = im.data() + (std::size_t(by) * std::size_t(w) + std::size_t(bx)) * 3;
+    for (int j = 0; j < 4; ++j) {
+      const float* p = base + std::size_t(j) * std::size_t(w) * 3;
+      float row[3] = {0, 0, 0};
+      for (int i = 0; i < 4; ++i)
+        for (int c = 0; c < 3; ++c) row[c] += wx[i] * p[i * 3 + c];
+      for (int c = 0; c < 3; ++c) acc[c] += wy[j] * row[c];
+    }
+  } else {
+    for (int j = 0; j < 4; ++j) {
+      const int yy = std::clamp(by + j, 0, h - 1);
+      float row[3] = {0, 0, 0};
+      for (int i = 0; i < 4; ++i) {
+        const float* p = im.pixel(std::clamp(bx + i, 0, w - 1), yy);
+        for (int c = 0; c < 3; ++c) row[c] += wx[i] * p[c];
+      }
+      for (int c = 0; c < 3; ++c) acc[c] += wy[j] * row[c];
     }
   }
-  for (int c = 0; c < 3; ++c) out[c] = float(acc[c]);
+  for (int c = 0; c < 3; ++c) out[c] = acc[c];
   return true;
 }
 
@@ -99,7 +120,9 @@ const FilterInfo& BmfrFilter::static_info() {
     i.summary = "Blockwise multi-order feature regression: temporal accumulation, per-block QR fit, TAA";
     i.reference = "Koskela et al., Blockwise Multi-Order Feature Regression for real-time path tracing reconstruction, ACM TOG 2019";
     i.params = with_common_params({
-        ParamSpec::Int("block_size", 32, 8, 128, "side of the square regression blocks in pixels"),
+        ParamSpec::Int("block_size", 0, 0, 128,
+                       "side of the square regression blocks in pixels (8..128); 0 = auto: 32 (the paper's) when the "
+                       "shorter image side is >= 360 pixels, 16 below"),
         ParamSpec::Float("epsilon", 0.01, 0.0, 10.0,
                          "stochastic regularisation: uniform noise in [-epsilon, epsilon] added to the fitted features"),
         ParamSpec::Float("alpha1", 0.2, 0.01, 1.0, "phase I: weight floor of the new noisy sample (cumulative average until then)"),
@@ -108,10 +131,18 @@ const FilterInfo& BmfrFilter::static_info() {
                         "feature set: default [1,n,w,w^2] (10), first_order [1,n,w] (7), with_albedo (+albedo, 13), "
                         "with_depth (+depth, 11)"),
         ParamSpec::Bool("offsets", true, "displace the block grid every frame by a fixed 16-entry random sequence"),
-        ParamSpec::Bool("taa", true, "temporal anti-aliasing (reprojected history clamped to the 3x3 min/max) at the end"),
+        ParamSpec::Bool("taa", true, "temporal anti-aliasing (reprojected history clipped to the 3x3 neighbourhood, see taa_clip) at the end"),
         ParamSpec::Float("taa_alpha", 0.2, 0.01, 1.0, "TAA: weight of the current frame"),
-        ParamSpec::Enum("taa_history", "bilinear", {"bilinear", "catmull_rom"},
-                        "TAA: history lookup (catmull_rom: sharper, Karis 2014; bilinear: lower relMSE on the samples)"),
+        ParamSpec::Enum("taa_clip", "ycocg_variance", {"ycocg_variance", "rgb_minmax"},
+                        "TAA history clipping box: ycocg_variance = 3x3 min/max intersected with mean +- taa_gamma "
+                        "standard deviations in YCoCg (Karis 2014, Salvi 2016); rgb_minmax = 3x3 min/max in RGB"),
+        ParamSpec::Float("taa_gamma", 1.0, 0.1, 10.0, "TAA: half-width of the variance box in standard deviations"),
+        ParamSpec::Enum("taa_history", "catmull_rom", {"bilinear", "catmull_rom"},
+                        "TAA: history lookup (catmull_rom: sharper, Karis 2014; bilinear blurs a moving image a little "
+                        "more every frame)"),
+        ParamSpec::Bool("fit_clamp", true,
+                        "clamp the fitted illumination to [min(0, block min), max(0, block max)] of the block's "
+                        "accumulated input (the paper clamps only at 0 implicitly; guards ill-conditioned blocks)"),
         ParamSpec::Int("seed", 0, 0, 2147483647, "seed of the regularisation noise"),
         ParamSpec::Bool("albedo_demodulation", true,
                         "fit illumination = colour / max(albedo, albedo_floor) and multiply back before TAA (when an albedo pass "
@@ -139,6 +170,8 @@ const FilterInfo& BmfrFilter::static_info() {
 }
 
 void BmfrFilter::check_params() {
+  const std::int64_t b = params_.get_int("block_size");
+  if (b != 0 && b < 8) throw Error(Errc::InvalidArgument, "filter 'bmfr': block_size must be 0 (auto) or 8..128, got " + std::to_string(b));
   AccumulationParams p;
   p.alpha = params_.get_float("alpha1");
   p.reprojection.relative_position = params_.get_enum("position_test") == "relative";
@@ -156,13 +189,37 @@ void BmfrFilter::reset() {
   last_cut_ = false;
 }
 
+int BmfrFilter::block_side(std::int64_t param, int w, int h) {
+  if (param > 0) return int(param);
+  return std::min(w, h) >= 360 ? 32 : 16;
+}
+
+namespace {
+void ensure_image(Image& im, int w, int h, int ch) {
+  if (im.width() != w || im.height() != h || im.channels() != ch) im = Image(w, h, ch);
+}
+
+// Per-thread scratch of the fit, sized once for the largest block.
+struct FitScratch {
+  std::vector<float> raw;    // R columns x np, planar
+  std::vector<float> feat;   // M columns x np, planar, scaled, noise-free
+  std::vector<unsigned char> fin;
+  std::vector<std::size_t> pix;
+  std::vector<int> rows;
+  std::vector<double> mat;   // W x (M + 3), column-major
+  std::vector<double> acc;   // 3 x np synthesis
+  AugmentedQr qr;
+};
+}  // namespace
+
 void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::vector<float>& valid, Image& fitted,
                             int nthreads) {
   const int w = frame.width, h = frame.height;
-  const int B = int(params_.get_int("block_size"));
+  const int B = block_side(params_.get_int("block_size"), w, h);
   const FeatureLayout lay = layout_of(params_.get_enum("features"));
   const double eps = params_.get_float("epsilon");
   const std::uint64_t seed = std::uint64_t(params_.get_int("seed"));
+  const bool clamp_max = params_.get_bool("fit_clamp");
   const Image& pos = frame.image(Role::Position, Prefer::Geometry);
   const Image& nrm = frame.image(Role::Normal, Prefer::Geometry);
   const Image* alb = lay.albedo ? &frame.image(Role::Albedo) : nullptr;
@@ -177,113 +234,187 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   // Blocks start at -ox + k B: the first and last ones are partial.
   const int nbx = (w + ox + B - 1) / B, nby = (h + oy + B - 1) / B;
   const int R = lay.raw(), M = lay.columns();
+  const std::size_t cap = std::size_t(B) * std::size_t(B);
+  const int pch = pos.channels(), nch = nrm.channels();
 
-  parallel_rows(0, nby, nthreads, [&](int by) {
-    std::vector<double> raw, feat, mat;
-    std::vector<std::size_t> pix;
-    std::vector<unsigned char> ffin;
-    std::vector<int> rows;
-    AugmentedQr qr;
-    for (int bx = 0; bx < nbx; ++bx) {
-      const int x0 = std::max(0, bx * B - ox), x1 = std::min(w, (bx + 1) * B - ox);
-      const int y0 = std::max(0, by * B - oy), y1 = std::min(h, (by + 1) * B - oy);
-      if (x1 <= x0 || y1 <= y0) continue;
-      const int np = (x1 - x0) * (y1 - y0);
-      pix.resize(std::size_t(np));
-      raw.assign(std::size_t(np) * R, 0.0);
-      ffin.assign(std::size_t(np), 1);
-      // Raw features; a pixel with any non-finite feature is left out of the fit and
-      // its features read as mid-range (0 after scaling).
-      int p = 0;
-      for (int y = y0; y < y1; ++y)
-        for (int x = x0; x < x1; ++x, ++p) {
-          pix[std::size_t(p)] = std::size_t(y) * w + x;
-          double* f = raw.data() + std::size_t(p) * R;
-          const float* n = nrm.pixel(x, y);
-          const float* q = pos.pixel(x, y);
-          f[0] = n[0]; f[1] = n[1]; f[2] = n[2];
-          f[3] = q[0]; f[4] = q[1]; f[5] = q[2];
-          int k = 6;
-          if (alb) {
-            const float* a = alb->pixel(x, y);
-            for (int c = 0; c < 3; ++c) f[k++] = a[std::min(c, alb->channels() - 1)];
+  // One task per block (rows of blocks would leave a thread idle on the last ones); the
+  // result of a block depends on (seed, frame, block) only.
+  const int nblocks = nbx * nby;
+  tbb::task_arena arena(arena_threads(nthreads));
+  tbb::enumerable_thread_specific<FitScratch> scratch;
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, nblocks, 1), [&](const tbb::blocked_range<int>& range) {
+      FitScratch& S = scratch.local();
+      if (S.fin.size() < cap) {
+        S.raw.resize(cap * std::size_t(R));
+        S.feat.resize(cap * std::size_t(M));
+        S.fin.resize(cap);
+        S.pix.resize(cap);
+        S.rows.resize(cap);
+        S.mat.resize(cap * std::size_t(M + 3));
+        S.acc.resize(cap * 3);
+      }
+      for (int b = range.begin(); b != range.end(); ++b) {
+        const int by = b / nbx, bx = b % nbx;
+        const int x0 = std::max(0, bx * B - ox), x1 = std::min(w, (bx + 1) * B - ox);
+        const int y0 = std::max(0, by * B - oy), y1 = std::min(h, (by + 1) * B - oy);
+        if (x1 <= x0 || y1 <= y0) continue;
+        const int bw = x1 - x0, np = bw * (y1 - y0);
+        const std::size_t snp = std::size_t(np);
+        float* raw = S.raw.data();
+        float* feat = S.feat.data();
+        unsigned char* fin = S.fin.data();
+        std::size_t* pix = S.pix.data();
+        // Raw features, planar; a pixel with any non-finite feature is left out of the fit
+        // and its features read as mid-range (0 after scaling).
+        int p = 0;
+        for (int y = y0; y < y1; ++y) {
+          const float* nrow = nrm.data() + (std::size_t(y) * w + x0) * nch;
+          const float* prow = pos.data() + (std::size_t(y) * w + x0) * pch;
+          for (int x = 0; x < bw; ++x, ++p) {
+            pix[p] = std::size_t(y) * w + std::size_t(x0 + x);
+            const float* n = nrow + std::size_t(x) * nch;
+            const float* q = prow + std::size_t(x) * pch;
+            raw[0 * snp + p] = n[0];
+            raw[1 * snp + p] = n[1];
+            raw[2 * snp + p] = n[2];
+            raw[3 * snp + p] = q[0];
+            raw[4 * snp + p] = q[1];
+            raw[5 * snp + p] = q[2];
+            int k = 6;
+            if (alb) {
+              const float* a = alb->pixel(x0 + x, y);
+              for (int c = 0; c < 3; ++c) raw[std::size_t(k++) * snp + p] = a[std::min(c, alb->channels() - 1)];
+            }
+            if (dep) raw[std::size_t(k++) * snp + p] = dep->pixel(x0 + x, y)[0];
+            bool f = true;
+            for (int c = 0; c < R; ++c) f = f && std::isfinite(raw[std::size_t(c) * snp + p]);
+            fin[p] = f ? 1 : 0;
           }
-          if (dep) f[k++] = dep->pixel(x, y)[0];
-          for (int c = 0; c < R; ++c)
-            if (!std::isfinite(f[c])) ffin[std::size_t(p)] = 0;
         }
-      // Scaled, noise-free features for every pixel (row-major np x M).
-      feat.assign(std::size_t(np) * M, 0.0);
-      auto scale_column = [&](int col, auto&& value) {
-        double lo = INFINITY, hi = -INFINITY;
-        for (int i = 0; i < np; ++i)
-          if (ffin[std::size_t(i)]) {
-            const double v = value(i);
-            lo = std::min(lo, v);
-            hi = std::max(hi, v);
+        // Scaled to [-1, 1] over the block's finite pixels; a column constant within float
+        // rounding is 0 (the constant column carries it).
+        auto scale_column = [&](const float* src, float* dst) {
+          float lo = INFINITY, hi = -INFINITY;
+          for (int i = 0; i < np; ++i)
+            if (fin[i]) {
+              lo = std::min(lo, src[i]);
+              hi = std::max(hi, src[i]);
+            }
+          const double range = double(hi) - double(lo);
+          if (!(range > 1e-5 * std::max(std::fabs(double(lo)), std::fabs(double(hi)))) || !(range > 1e-30) ||
+              !std::isfinite(range)) {
+            std::fill(dst, dst + np, 0.0f);
+            return;
           }
-        const double range = hi - lo;
-        // Constant within float rounding: the column is 0 (the constant column carries it).
-        if (!(range > 1e-5 * std::max(std::fabs(lo), std::fabs(hi))) || !(range > 1e-30) || !std::isfinite(range)) return;
+          const float sc = float(2.0 / range);
+          for (int i = 0; i < np; ++i) {
+            const float v = std::clamp((src[i] - lo) * sc - 1.0f, -1.0f, 1.0f);
+            dst[i] = fin[i] ? v : 0.0f;
+          }
+        };
+        std::fill(feat, feat + np, 1.0f);
+        // Columns: 0 constant; 1..3 normal; 4..6 position; [7..9 position^2]; extras.
+        for (int c = 0; c < R; ++c) {
+          const int col = c < 6 ? 1 + c : 1 + c + (lay.squares ? 3 : 0);
+          scale_column(raw + std::size_t(c) * snp, feat + std::size_t(col) * snp);
+        }
+        if (lay.squares)
+          for (int c = 0; c < 3; ++c) {
+            // Square of the scaled position: the same span as w^2 with w, better conditioned.
+            float* sq = raw;  // raw column 0 is no longer needed: reuse as scratch
+            const float* s0 = feat + std::size_t(4 + c) * snp;
+            for (int i = 0; i < np; ++i) sq[i] = s0[i] * s0[i];
+            scale_column(sq, feat + std::size_t(7 + c) * snp);
+          }
+        // Fitted rows: valid colour and finite features.
+        int W = 0;
         for (int i = 0; i < np; ++i)
-          if (ffin[std::size_t(i)]) feat[std::size_t(i) * M + col] = std::clamp(2.0 * (value(i) - lo) / range - 1.0, -1.0, 1.0);
-      };
-      for (int i = 0; i < np; ++i) feat[std::size_t(i) * M] = 1.0;
-      // Columns: 0 constant; 1..3 normal; 4..6 position; [7..9 position^2]; extras.
-      for (int c = 0; c < R; ++c) {
-        const int col = c < 6 ? 1 + c : 1 + c + (lay.squares ? 3 : 0);
-        scale_column(col, [&](int i) { return raw[std::size_t(i) * R + c]; });
-      }
-      if (lay.squares)
-        for (int c = 0; c < 3; ++c) {
-          // Square of the scaled position: the same span as w^2 with w, better conditioned.
-          scale_column(7 + c, [&](int i) {
-            const double s = feat[std::size_t(i) * M + 4 + c];
-            return s * s;
-          });
+          if (fin[i] && valid[pix[i]] > 0.0f) S.rows[std::size_t(W++)] = i;
+        if (W == 0) {
+          for (int i = 0; i < np; ++i)
+            for (int c = 0; c < 3; ++c) fitted.data()[pix[i] * 3 + c] = std::numeric_limits<float>::quiet_NaN();
+          continue;
         }
-      // Fitted rows: valid colour and finite features.
-      rows.clear();
-      for (int i = 0; i < np; ++i)
-        if (ffin[std::size_t(i)] && valid[pix[std::size_t(i)]] > 0.0f) rows.push_back(i);
-      const int W = int(rows.size());
-      if (W == 0) {
-        for (int i = 0; i < np; ++i)
-          for (int c = 0; c < 3; ++c) fitted.data()[pix[std::size_t(i)] * 3 + c] = std::numeric_limits<float>::quiet_NaN();
-        continue;
-      }
-      mat.assign(std::size_t(W) * (M + 3), 0.0);
-      std::uint64_t rng = seed * 0x2545F4914F6CDD1Dull ^ (std::uint64_t(frame_index_) << 32) ^
-                          (std::uint64_t(by) * 65537u + std::uint64_t(bx) + 1);
-      splitmix(rng);
-      double zmin[3] = {INFINITY, INFINITY, INFINITY};
-      for (int r = 0; r < W; ++r) {
-        const int i = rows[std::size_t(r)];
-        mat[std::size_t(r)] = 1.0;  // no noise on the constant: a constant block stays exact
-        for (int m = 1; m < M; ++m)
-          mat[std::size_t(m) * W + r] = feat[std::size_t(i) * M + m] + (eps > 0 ? eps * uniform_pm1(rng) : 0.0);
-        const float* z = illum.data() + pix[std::size_t(i)] * 3;
+        double* mat = S.mat.data();
+        const std::size_t sW = std::size_t(W);
+        std::uint64_t rng = seed * 0x2545F4914F6CDD1Dull ^ (std::uint64_t(frame_index_) << 32) ^
+                            (std::uint64_t(by) * 65537u + std::uint64_t(bx) + 1);
+        // Per-block noise stream: xorshift64 seeded by splitmix of (seed, frame, block),
+        // two 32-bit uniforms in [-1, 1) per step (plenty for a regulariser).
+        std::uint64_t xs = splitmix(rng) | 1u;
+        const int* rows = S.rows.data();
+        const bool dense = W == np;  // every pixel fitted: rows[r] == r
+        for (int r = 0; r < W; ++r) mat[r] = 1.0;  // no noise on the constant: a constant block stays exact
+        // The noise goes on the fitted features only, never on the synthesis ones.
+        const double e31 = eps * (1.0 / 2147483648.0);
+        for (int m = 1; m < M; ++m) {
+          double* col = mat + std::size_t(m) * sW;
+          const float* fm = feat + std::size_t(m) * snp;
+          if (dense)
+            for (int r = 0; r < W; ++r) col[r] = double(fm[r]);
+          else
+            for (int r = 0; r < W; ++r) col[r] = double(fm[rows[r]]);
+          if (eps > 0) {
+            int r = 0;
+            for (; r + 2 <= W; r += 2) {
+              xs ^= xs << 13;
+              xs ^= xs >> 7;
+              xs ^= xs << 17;
+              col[r] += e31 * double(std::int32_t(std::uint32_t(xs)));
+              col[r + 1] += e31 * double(std::int32_t(std::uint32_t(xs >> 32)));
+            }
+            if (r < W) {
+              xs ^= xs << 13;
+              xs ^= xs >> 7;
+              xs ^= xs << 17;
+              col[r] += e31 * double(std::int32_t(std::uint32_t(xs >> 32)));
+            }
+          }
+        }
+        double zmin[3] = {INFINITY, INFINITY, INFINITY}, zmax[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int c = 0; c < 3; ++c) {
-          mat[std::size_t(M + c) * W + r] = z[c];
-          zmin[c] = std::min(zmin[c], double(z[c]));
+          double* col = mat + std::size_t(M + c) * sW;
+          double zm = INFINITY, zx = -INFINITY;
+          for (int r = 0; r < W; ++r) {
+            const double z = illum.data()[pix[rows[r]] * 3 + std::size_t(c)];
+            col[r] = z;
+            zm = std::min(zm, z);
+            zx = std::max(zx, z);
+          }
+          zmin[c] = zm;
+          zmax[c] = zx;
+        }
+        S.qr.factorize(mat, W, M, 3);
+        double alpha[3][32];
+        for (int c = 0; c < 3; ++c) S.qr.solve(c, alpha[c]);
+        // Synthesis with the noise-free features (planar, vectorised over the pixels).
+        double* acc = S.acc.data();
+        for (int c = 0; c < 3; ++c) {
+          double* ac = acc + std::size_t(c) * snp;
+          const double a0 = alpha[c][0];
+          for (int i = 0; i < np; ++i) ac[i] = a0;
+          for (int m = 1; m < M; ++m) {
+            const double am = alpha[c][m];
+            if (am == 0.0) continue;
+            const float* fm = feat + std::size_t(m) * snp;
+            for (int i = 0; i < np; ++i) ac[i] += am * double(fm[i]);
+          }
+        }
+        for (int i = 0; i < np; ++i) {
+          float* o = fitted.data() + pix[i] * 3;
+          for (int c = 0; c < 3; ++c) {
+            // Radiance is not negative: no fit below min(0, the block's smallest input).
+            // Nor above the block's largest input: an ill-conditioned fit extrapolating at
+            // the pixels it was not fitted on (invalid ones, partial edge blocks) cannot
+            // make a highlight brighter than anything it was given.
+            double v = std::max(acc[std::size_t(c) * snp + i], std::min(0.0, zmin[c]));
+            if (clamp_max) v = std::min(v, std::max(0.0, zmax[c]));
+            o[c] = std::isfinite(v) ? float(std::clamp(v, -kFloatMax, kFloatMax)) : std::numeric_limits<float>::quiet_NaN();
+          }
         }
       }
-      qr.factorize(mat.data(), W, M, 3);
-      double alpha[3][32];
-      for (int c = 0; c < 3; ++c) qr.solve(c, alpha[c]);
-      // Synthesis with the noise-free features.
-      for (int i = 0; i < np; ++i) {
-        const double* f = feat.data() + std::size_t(i) * M;
-        float* o = fitted.data() + pix[std::size_t(i)] * 3;
-        for (int c = 0; c < 3; ++c) {
-          double s = 0;
-          for (int m = 0; m < M; ++m) s += alpha[c][m] * f[m];
-          // Radiance is not negative: no fit below min(0, the block's smallest input).
-          s = std::max(s, std::min(0.0, zmin[c]));
-          o[c] = std::isfinite(s) ? float(std::clamp(s, -kFloatMax, kFloatMax)) : std::numeric_limits<float>::quiet_NaN();
-        }
-      }
-    }
+    });
   });
 }
 
@@ -295,11 +426,12 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   if (lay.depth && !frame.has(Role::Depth))
     throw Error(Errc::MissingPass, "filter 'bmfr': features=with_depth needs the depth pass, absent in '" + frame.path + "'");
   stage_ms_.fill(0.0);
+  stage_cpu_ms_.fill(0.0);
   auto t0 = std::chrono::steady_clock::now();
+  double c0 = cpu_now_ms();
 
   // Albedo guard: [albedo_floor, inf) per channel, non-finite reads as 1.
   const std::size_t n = std::size_t(w) * h;
-  std::vector<float> albedo;
   const Pass* ap = frame.find(Role::Albedo);
   // The common `demodulate` parameter, when set, has the base class divide before run()
   // and multiply after (TAA then sees the illumination): our own step is skipped so the
@@ -308,27 +440,33 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   const bool demod = params_.get_bool("albedo_demodulation") && ap && !base_demod;
   if (params_.get_bool("albedo_demodulation") && !ap) note("no albedo pass: the colour is fitted without demodulation");
   if (params_.get_bool("albedo_demodulation") && base_demod) note("demodulate=true: the base class demodulates; albedo_demodulation skipped");
-  Image illum(w, h, 3);
-  if (demod) albedo.resize(n * 3);
-  {
+  // Demodulation fused into phase I: row y of the illumination is made right before
+  // phase I reads it.
+  std::function<void(int)> demod_row;
+  if (demod) {
+    ensure_image(illum_, w, h, 3);
+    ensure_image(albedo_, w, h, 3);
     const float lo = float(params_.get_float("albedo_floor"));
-    parallel_rows(0, h, nthreads, [&](int y) {
-      for (std::size_t i = std::size_t(y) * w; i < std::size_t(y + 1) * w; ++i)
+    const Image& ai = ap->image;
+    const int ach = ai.channels();
+    demod_row = [&, lo, ach](int y) {
+      const std::size_t b = std::size_t(y) * w, e = b + std::size_t(w);
+      float* il = illum_.data();
+      float* al = albedo_.data();
+      const float* co = colour.data();
+      const float* ad = ai.data();
+      for (std::size_t i = b; i < e; ++i)
         for (int c = 0; c < 3; ++c) {
-          float a = 1.0f;
-          if (demod) {
-            const Image& ai = ap->image;
-            const float v = ai.data()[i * std::size_t(ai.channels()) + std::size_t(std::min(c, ai.channels() - 1))];
-            a = std::isfinite(v) ? std::max(v, lo) : 1.0f;
-            albedo[i * 3 + c] = a;
-          }
-          illum.data()[i * 3 + c] = colour.data()[i * 3 + c] / a;
+          const float v = ad[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];
+          const float a = std::isfinite(v) ? std::max(v, lo) : 1.0f;
+          al[i * 3 + c] = a;
+          il[i * 3 + c] = co[i * 3 + c] / a;
         }
-    });
+    };
   }
 
-  // Phase I.
-  const Image& acc1 = phase1_.accumulate(frame, illum, nthreads);
+  // Phase I (reprojection fused with the accumulation).
+  const Image& acc1 = demod ? phase1_.accumulate(frame, illum_, demod_row, nthreads) : phase1_.accumulate(frame, colour, nthreads);
   const Reprojection& rep = phase1_.last_reprojection();
   last_cut_ = rep.cut;
   if (rep.cut) note("camera cut: " + std::to_string(rep.discarded) + " of " + std::to_string(n) + " pixels lost their history; restarted");
@@ -337,73 +475,201 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     taa_history_ = Image();
   }
   stage_ms_[kAccumulate] = ms_since(t0);
+  stage_cpu_ms_[kAccumulate] = cpu_now_ms() - c0;
 
   // Phase II.
   t0 = std::chrono::steady_clock::now();
-  Image fitted(w, h, 3);
-  fit_blocks(frame, acc1, phase1_.sample_count(), fitted, nthreads);
+  c0 = cpu_now_ms();
+  ensure_image(fitted_, w, h, 3);
+  fit_blocks(frame, acc1, phase1_.sample_count(), fitted_, nthreads);
   stage_ms_[kFit] = ms_since(t0);
+  stage_cpu_ms_[kFit] = cpu_now_ms() - c0;
 
-  // Phase III: second accumulation on the same reprojection, then remodulation.
+  // Phase III: second accumulation on phase I's reprojection (its discard decisions),
+  // remodulation and (for TAA) the conversion to its clipping space, in one pass.
   t0 = std::chrono::steady_clock::now();
-  Image result = phase3_.accumulate(rep, fitted, params_.get_float("alpha2"), nthreads);
+  c0 = cpu_now_ms();
+  const bool use_taa = params_.get_bool("taa");
+  const bool hist = use_taa && !taa_history_.empty() && taa_history_.width() == w && taa_history_.height() == h &&
+                    rep.has_history && !rep.cut;
+  const bool ycocg = params_.get_enum("taa_clip") == "ycocg_variance";
+  const double alpha2 = params_.get_float("alpha2");
+  ensure_image(result_, w, h, 3);
+  if (hist) space_.resize(n * 3);
+  phase3_.begin(rep, fitted_);
   parallel_rows(0, h, nthreads, [&](int y) {
-    float* r = result.data() + std::size_t(y) * w * 3;
-    const float* a = demod ? albedo.data() + std::size_t(y) * w * 3 : nullptr;
+    phase3_.row(y, rep, fitted_, alpha2);
+    const float* s = phase3_.pending().data() + std::size_t(y) * w * 3;
+    float* r = result_.data() + std::size_t(y) * w * 3;
+    const float* a = demod ? albedo_.data() + std::size_t(y) * w * 3 : nullptr;
     for (std::size_t i = 0; i < std::size_t(w) * 3; ++i) {
-      const double v = a ? double(r[i]) * a[i] : double(r[i]);
-      r[i] = float(std::clamp(v, -kFloatMax, kFloatMax));
+      const float v = a ? s[i] * a[i] : s[i];
+      r[i] = std::isfinite(v) ? v : (std::isnan(v) ? v : std::copysign(std::numeric_limits<float>::max(), v));
+    }
+    if (!hist) return;
+    float* s0 = space_.data() + std::size_t(y) * w;
+    float* s1 = s0 + n;
+    float* s2 = s1 + n;
+    for (int x = 0; x < w; ++x) {
+      const float R = r[x * 3], G = r[x * 3 + 1], B = r[x * 3 + 2];
+      if (ycocg) {
+        s0[x] = 0.25f * R + 0.5f * G + 0.25f * B;
+        s1[x] = 0.5f * R - 0.5f * B;
+        s2[x] = -0.25f * R + 0.5f * G - 0.25f * B;
+      } else {
+        s0[x] = R;
+        s1[x] = G;
+        s2[x] = B;
+      }
     }
   });
+  phase3_.finish();
   stage_ms_[kPost] = ms_since(t0);
+  stage_cpu_ms_[kPost] = cpu_now_ms() - c0;
 
-  // TAA (Karis 2014): previous output reprojected by the motion pass (bilinear or Catmull-Rom),
-  // clamped to the 3x3 min/max of the current result, blended with weight taa_alpha for
-  // the current frame.
   t0 = std::chrono::steady_clock::now();
-  if (params_.get_bool("taa")) {
-    const float a = float(params_.get_float("taa_alpha"));
-    const bool cubic = params_.get_enum("taa_history") == "catmull_rom";
-    Image taa(w, h, 3);
-    const bool hist = !taa_history_.empty() && taa_history_.width() == w && taa_history_.height() == h && rep.has_history && !rep.cut;
-    parallel_rows(0, h, nthreads, [&](int y) {
-      for (int x = 0; x < w; ++x) {
-        const float* c = result.pixel(x, y);
-        float* o = taa.pixel(x, y);
-        std::copy(c, c + 3, o);
-        if (!hist) continue;
-        const std::size_t i = std::size_t(y) * w + x;
-        float hv[3];
-        if (cubic) {
-          if (!rep.inside[i] || !catmull_rom(taa_history_, rep.prev_x[i], rep.prev_y[i], hv)) continue;
-        } else if (rep.sample(i, taa_history_.data(), 3, rep.inside[i], hv, [](std::size_t) { return true; }) <= 0.0f) {
-          continue;
-        }
-        float lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-        for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-          for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
-            const float* q = result.pixel(xx, yy);
-            for (int k = 0; k < 3; ++k) {
-              lo[k] = std::min(lo[k], q[k]);
-              hi[k] = std::max(hi[k], q[k]);
-            }
-          }
-        for (int k = 0; k < 3; ++k) {
-          const float hc = std::clamp(hv[k], lo[k], hi[k]);
-          o[k] = float(double(hc) + double(a) * (double(c[k]) - double(hc)));
-        }
-      }
-    });
-    taa_history_ = std::move(taa);
+  c0 = cpu_now_ms();
+  if (use_taa) {
+    taa(rep, hist, nthreads);
   } else {
     taa_history_ = Image();
   }
   stage_ms_[kTaa] = ms_since(t0);
+  stage_cpu_ms_[kTaa] = cpu_now_ms() - c0;
 
-  const Image& final_image = params_.get_bool("taa") ? taa_history_ : result;
+  const Image& final_image = use_taa ? taa_history_ : result_;
   for (int y = roi.y0; y < roi.y1; ++y)
     std::copy(final_image.pixel(roi.x0, y), final_image.pixel(roi.x0, y) + std::size_t(roi.width()) * 3, out.pixel(roi.x0, y));
   ++frame_index_;
+}
+
+// TAA (Karis 2014): the previous output reprojected by the motion pass (bilinear or
+// Catmull-Rom), clipped to the current result's 3x3 neighbourhood, blended with weight
+// taa_alpha for the current frame. taa_clip=ycocg_variance: the box is the intersection
+// of the 3x3 min/max and mean +- taa_gamma standard deviations (Salvi 2016), in YCoCg
+// (Karis 2014): tighter than the plain min/max, which lets outliers of the fit through.
+// taa_clip=rgb_minmax: the 3x3 min/max in RGB.
+void BmfrFilter::taa(const Reprojection& rep, bool hist, int nthreads) {
+  const int w = result_.width(), h = result_.height();
+  const std::size_t n = std::size_t(w) * h;
+  const float a = float(params_.get_float("taa_alpha"));
+  const bool cubic = params_.get_enum("taa_history") == "catmull_rom";
+  const bool ycocg = params_.get_enum("taa_clip") == "ycocg_variance";
+  const float gamma = float(params_.get_float("taa_gamma"));
+  ensure_image(taa_next_, w, h, 3);
+  if (!hist) {
+    std::copy(result_.storage().begin(), result_.storage().end(), taa_next_.storage().begin());
+    std::swap(taa_history_, taa_next_);
+    return;
+  }
+  // space_ holds the result in the clipping space, planar (made in phase III).
+  parallel_rows(0, h, nthreads, [&](int y) {
+    // Column statistics over rows y-1..y+1 (clamped: the border pixel counts twice),
+    // with one pixel of padding on each side, then the 3-wide sums along the row.
+    thread_local std::vector<float> col;
+    col.resize(std::size_t(w + 2) * 12);
+    const int ya = std::max(0, y - 1), yb = std::min(h - 1, y + 1);
+    for (int c = 0; c < 3; ++c) {
+      const float* p0 = space_.data() + std::size_t(c) * n + std::size_t(ya) * w;
+      const float* p1 = space_.data() + std::size_t(c) * n + std::size_t(y) * w;
+      const float* p2 = space_.data() + std::size_t(c) * n + std::size_t(yb) * w;
+      float* cs = col.data() + std::size_t(c) * 4 * (w + 2);
+      float* cq = cs + (w + 2);
+      float* cmn = cq + (w + 2);
+      float* cmx = cmn + (w + 2);
+      for (int x = 0; x < w; ++x) {
+        const float v0 = p0[x], v1 = p1[x], v2 = p2[x];
+        cs[x + 1] = v0 + v1 + v2;
+        cq[x + 1] = v0 * v0 + v1 * v1 + v2 * v2;
+        cmn[x + 1] = std::min(v0, std::min(v1, v2));
+        cmx[x + 1] = std::max(v0, std::max(v1, v2));
+      }
+      cs[0] = cs[1]; cq[0] = cq[1]; cmn[0] = cmn[1]; cmx[0] = cmx[1];
+      cs[w + 1] = cs[w]; cq[w + 1] = cq[w]; cmn[w + 1] = cmn[w]; cmx[w + 1] = cmx[w];
+    }
+    const float* hist_data = taa_history_.data();
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * w + x;
+      const float* c = result_.data() + i * 3;
+      float* o = taa_next_.data() + i * 3;
+      float hv[3];
+      bool ok;
+      if (cubic) {
+        ok = rep.inside[i] && catmull_rom(taa_history_, rep.prev_x[i], rep.prev_y[i], hv);
+      } else {
+        ok = rep.sample(i, hist_data, 3, rep.inside[i], hv, [](std::size_t) { return true; }) > 0.0f;
+      }
+      if (!ok) {
+        o[0] = c[0]; o[1] = c[1]; o[2] = c[2];
+        continue;
+      }
+      float hs[3];
+      if (ycocg) {
+        hs[0] = 0.25f * hv[0] + 0.5f * hv[1] + 0.25f * hv[2];
+        hs[1] = 0.5f * hv[0] - 0.5f * hv[2];
+        hs[2] = -0.25f * hv[0] + 0.5f * hv[1] - 0.25f * hv[2];
+      } else {
+        hs[0] = hv[0]; hs[1] = hv[1]; hs[2] = hv[2];
+      }
+      float blo[3], bhi[3];
+      for (int k = 0; k < 3; ++k) {
+        const float* cs = col.data() + std::size_t(k) * 4 * (w + 2);
+        const float* cq = cs + (w + 2);
+        const float* cmn = cq + (w + 2);
+        const float* cmx = cmn + (w + 2);
+        float lo = std::min(cmn[x], std::min(cmn[x + 1], cmn[x + 2]));
+        float hi = std::max(cmx[x], std::max(cmx[x + 1], cmx[x + 2]));
+        if (ycocg) {
+          const float mean = (cs[x] + cs[x + 1] + cs[x + 2]) * (1.0f / 9.0f);
+          const float var = std::max(0.0f, (cq[x] + cq[x + 1] + cq[x + 2]) * (1.0f / 9.0f) - mean * mean);
+          const float sd = gamma * std::sqrt(var);
+          // The box always holds the current pixel: a history equal to it passes.
+          const float cur = space_[std::size_t(k) * n + i];
+          lo = std::max(lo, std::min(mean - sd, cur));
+          hi = std::min(hi, std::max(mean + sd, cur));
+        }
+        blo[k] = lo;
+        bhi[k] = hi;
+      }
+      if (ycocg) {
+        // Clip towards the box centre along the line to the history (Karis 2014): keeps
+        // the history's hue instead of moving each channel on its own.
+        // A channel whose box is flat (within float rounding of the luma) does not steer
+        // the clip: the final clamp handles it.
+        float ratio = 1.0f;
+        float ctr[3], d[3];
+        for (int k = 0; k < 3; ++k) {
+          ctr[k] = 0.5f * (blo[k] + bhi[k]);
+          d[k] = hs[k] - ctr[k];
+        }
+        const float tol = 1e-5f * (std::fabs(ctr[0]) + 0.5f * (bhi[0] - blo[0])) + 1e-30f;
+        for (int k = 0; k < 3; ++k) {
+          const float ext = 0.5f * (bhi[k] - blo[k]);
+          const float ad = std::fabs(d[k]);
+          if (ext > tol && ad > ext) ratio = std::max(ratio, ad / ext);
+        }
+        if (ratio > 1.0f && std::isfinite(ratio))
+          for (int k = 0; k < 3; ++k) hs[k] = ctr[k] + d[k] / ratio;
+        for (int k = 0; k < 3; ++k) hs[k] = std::clamp(hs[k], blo[k], bhi[k]);
+      } else {
+        for (int k = 0; k < 3; ++k) hs[k] = std::clamp(hs[k], blo[k], bhi[k]);
+      }
+      float hc[3];
+      if (ycocg) {
+        const float t = hs[0] - hs[2];
+        hc[0] = t + hs[1];
+        hc[1] = hs[0] + hs[2];
+        hc[2] = t - hs[1];
+      } else {
+        hc[0] = hs[0]; hc[1] = hs[1]; hc[2] = hs[2];
+      }
+      for (int k = 0; k < 3; ++k) {
+        const float v = hc[k] + a * (c[k] - hc[k]);
+        o[k] = std::isfinite(v) ? v : c[k];
+      }
+    }
+  });
+  std::swap(taa_history_, taa_next_);
 }
 
 }  // namespace mcr

@@ -12,7 +12,16 @@ namespace mcr {
 //   demodulation by albedo -> I: temporal accumulation of the noisy illumination
 //   -> II: per-block least-squares fit of the illumination to multi-order features
 //      [1, n, w, w^2] (augmented Householder QR, stochastic regularisation, displaced grid)
-//   -> III: second accumulation of the fit, remodulation, TAA (Karis 2014).
+//   -> III: second accumulation of the fit, remodulation, TAA (Karis 2014: Catmull-Rom
+//      history, clipped towards the centre of a YCoCg box = 3x3 min/max intersected with
+//      mean +- taa_gamma sigma, Salvi 2016).
+// block_size = 0 (default) picks the block side from the frame: the paper's 32 when the
+// shorter side has >= 360 pixels (720p and up), 16 below (e.g. the 160x90 samples, where
+// a 32-pixel block spans a third of the image height).
+// Speed: every per-frame buffer is kept between frames; the reprojection and the albedo
+// demodulation run in the same row pass as phase I, and phase III, remodulation and the
+// TAA colour-space conversion in one pass; the fit works on planar float features per
+// block (double only in the QR and the synthesis sums), one task per block.
 // Temporal: history lives in the object; reset() drops it. A size change or a camera
 // cut (more than cut_fraction of the pixels lose every reprojection tap) restarts it.
 // The whole frame is always processed (history needs it); only the roi is written.
@@ -26,12 +35,18 @@ class BmfrFilter : public Filter {
   // (fit), phase III (second accumulation + remodulation), TAA.
   enum Stage { kAccumulate, kFit, kPost, kTaa, kStages };
   const std::array<double, kStages>& stage_ms() const { return stage_ms_; }
+  // The same stages in process CPU time (all threads), ms: robust on a loaded machine.
+  const std::array<double, kStages>& stage_cpu_ms() const { return stage_cpu_ms_; }
   // Whether the last execute() detected a camera cut, and frames processed since reset().
   bool last_cut() const { return last_cut_; }
   std::int64_t frame_index() const { return frame_index_; }
 
   // The 16 fixed grid displacements, as fractions of the block size.
   static const std::array<std::array<float, 2>, 16>& grid_offsets();
+  // The block side used for a w x h frame with block_size = `param` (0 = auto: 32, the
+  // paper's size, when the shorter side has 360 pixels or more; 16 below, where 32-pixel
+  // blocks would span a large part of the image).
+  static int block_side(std::int64_t param, int w, int h);
 
  protected:
   void check_params() override;
@@ -39,13 +54,18 @@ class BmfrFilter : public Filter {
 
  private:
   void fit_blocks(const Frame& frame, const Image& illum, const std::vector<float>& valid, Image& fitted, int nthreads);
+  void taa(const Reprojection& rep, bool history, int nthreads);
 
   TemporalAccumulator phase1_;
   AccumulationBuffer phase3_;
   Image taa_history_;
+  // Per-frame work buffers, kept between frames so that a steady sequence allocates nothing.
+  Image illum_, albedo_, fitted_, result_, taa_next_;
+  std::vector<float> space_;  // TAA: the result in the clipping colour space, planar
   std::int64_t frame_index_ = 0;
   bool last_cut_ = false;
   std::array<double, kStages> stage_ms_{};
+  std::array<double, kStages> stage_cpu_ms_{};
 };
 
 }  // namespace mcr

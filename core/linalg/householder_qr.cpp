@@ -7,7 +7,7 @@ namespace mcr {
 
 namespace {
 
-double dot(const double* a, const double* b, int n) {
+inline __attribute__((always_inline)) double dot(const double* a, const double* b, int n) {
   double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
   int i = 0;
   for (; i + 4 <= n; i += 4) {
@@ -22,7 +22,7 @@ double dot(const double* a, const double* b, int n) {
 
 // Norm without overflow for huge entries (1e200 squared would be inf): the plain sum
 // of squares first, the scaled one only when that over- or underflows.
-double safe_norm(const double* a, int n) {
+inline __attribute__((always_inline)) double safe_norm(const double* a, int n) {
   const double s = dot(a, a, n);
   if (std::isfinite(s) && (s > 1e-280 || s == 0.0)) return std::sqrt(s);
   double m = 0;
@@ -38,6 +38,15 @@ double safe_norm(const double* a, int n) {
 
 }  // namespace
 
+// The Householder updates are long dot products and axpys over the block's rows: built
+// for AVX2 as well where the compiler and loader support it (picked at load time).
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define MCR_QR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define MCR_QR_CLONES
+#endif
+
+MCR_QR_CLONES
 int AugmentedQr::factorize(double* a, int rows, int features, int rhs, const QrOptions& opt) {
   features_ = features;
   rhs_ = rhs;
@@ -46,8 +55,14 @@ int AugmentedQr::factorize(double* a, int rows, int features, int rhs, const QrO
   kept_.assign(std::size_t(features), 0);
   pivot_col_.clear();
   r_.clear();
-  std::vector<double> original(static_cast<std::size_t>(features));
-  for (int j = 0; j < features; ++j) original[std::size_t(j)] = safe_norm(a + std::size_t(j) * rows, rows);
+  double original_small[64];
+  std::vector<double> original_big;
+  double* original = original_small;
+  if (features > 64) {
+    original_big.resize(std::size_t(features));
+    original = original_big.data();
+  }
+  for (int j = 0; j < features; ++j) original[j] = safe_norm(a + std::size_t(j) * rows, rows);
   const double abs_floor = opt.abs_tol * std::sqrt(double(std::max(rows, 1)));
 
   int r = 0;  // next row to use = number of kept columns so far
@@ -55,7 +70,7 @@ int AugmentedQr::factorize(double* a, int rows, int features, int rhs, const QrO
     double* v = a + std::size_t(j) * rows + r;
     const int n = rows - r;
     const double norm = safe_norm(v, n);
-    if (!(norm > opt.rel_tol * original[std::size_t(j)]) || !(norm > abs_floor) || !std::isfinite(norm)) continue;
+    if (!(norm > opt.rel_tol * original[j]) || !(norm > abs_floor) || !std::isfinite(norm)) continue;
     // Householder vector v = x + sign(x0) |x| e0, H = I - 2 v v^T / (v^T v).
     const double alpha = v[0] >= 0 ? -norm : norm;
     v[0] -= alpha;

@@ -10,56 +10,95 @@ namespace mcr {
 
 void AccumulationBuffer::reset() {
   value_ = Image();
+  next_ = Image();
   count_.clear();
+  next_count_.clear();
+}
+
+void AccumulationBuffer::begin(const Reprojection& r, const Image& current) {
+  const int w = current.width(), h = current.height(), ch = current.channels();
+  if (ch > 8) throw Error(Errc::Internal, "accumulation: at most 8 channels");
+  usable_ = r.has_history && !r.cut && value_.width() == w && value_.height() == h && value_.channels() == ch &&
+            r.width == w && r.height == h && count_.size() == current.pixel_count();
+  if (next_.width() != w || next_.height() != h || next_.channels() != ch) next_ = Image(w, h, ch);
+  next_count_.resize(current.pixel_count());  // every entry is rewritten by row()
+}
+
+void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current, double alpha) {
+  const int w = current.width(), h = current.height(), ch = current.channels();
+  const float* hist = usable_ ? value_.data() : nullptr;
+  const float* hcount = usable_ ? count_.data() : nullptr;
+  const float af = float(alpha);
+  const float* crow = current.data() + std::size_t(y) * w * ch;
+  float* orow = next_.data() + std::size_t(y) * w * ch;
+  float* ncount = next_count_.data() + std::size_t(y) * w;
+  for (int x = 0; x < w; ++x) {
+    const std::size_t i = std::size_t(y) * w + x;
+    const float* c = crow + std::size_t(x) * ch;
+    float* o = orow + std::size_t(x) * ch;
+    bool finite = true;
+    for (int k = 0; k < ch; ++k) finite = finite && std::isfinite(c[k]);
+    float hv[8] = {0, 0, 0, 0, 0, 0, 0, 0};
+    float n = 0;
+    bool have = false;
+    const std::uint8_t mask = hist ? r.taps[i] : 0;
+    if (mask) {
+      // Bilinear taps that passed the tests and hold a valid history, value and count in
+      // one go, normalised by the kept weights only.
+      const float px = r.prev_x[i], py = r.prev_y[i];
+      const int x0 = floor_int(px), y0 = floor_int(py);
+      const float fx0 = float(x0), fy0 = float(y0);
+      const float fx = px - fx0, fy = py - fy0;
+      const float wt[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+      float sum = 0, cnt = 0;
+      for (int k = 0; k < 4; ++k) {
+        if (!(mask & (1u << k)) || wt[k] <= 0.0f) continue;
+        const std::size_t t = std::size_t(y0 + (k >> 1)) * std::size_t(w) + std::size_t(x0 + (k & 1));
+        const float tc = hcount[t];
+        if (!(tc > 0.0f)) continue;
+        sum += wt[k];
+        cnt += wt[k] * tc;
+        const float* hp = hist + t * std::size_t(ch);
+        for (int k2 = 0; k2 < ch; ++k2) hv[k2] += wt[k] * hp[k2];
+      }
+      if (sum > 1e-6f) {
+        const float inv = 1.0f / sum;
+        for (int k2 = 0; k2 < ch; ++k2) hv[k2] *= inv;
+        n = std::max(1.0f, float(int(cnt * inv + 0.5f)));  // counts are >= 0: round half up
+        have = true;
+      }
+    }
+    if (!finite) {
+      if (have) {
+        std::copy(hv, hv + ch, o);
+        ncount[x] = n;
+      } else {  // invalid, value 0, count 0
+        std::fill(o, o + ch, 0.0f);
+        ncount[x] = 0.0f;
+      }
+      continue;
+    }
+    if (!have) {
+      std::copy(c, c + ch, o);
+      ncount[x] = 1.0f;
+      continue;
+    }
+    const float wn = std::max(1.0f / (n + 1.0f), af);
+    for (int k = 0; k < ch; ++k) o[k] = hv[k] + wn * (c[k] - hv[k]);
+    ncount[x] = std::min(n + 1.0f, 65535.0f);
+  }
+  (void)h;
+}
+
+void AccumulationBuffer::finish() {
+  std::swap(value_, next_);
+  std::swap(count_, next_count_);
 }
 
 const Image& AccumulationBuffer::accumulate(const Reprojection& r, const Image& current, double alpha, int nthreads) {
-  const int w = current.width(), h = current.height(), ch = current.channels();
-  if (ch > 8) throw Error(Errc::Internal, "accumulation: at most 8 channels");
-  const bool usable = r.has_history && !r.cut && value_.width() == w && value_.height() == h &&
-                      value_.channels() == ch && r.width == w && r.height == h;
-  Image next(w, h, ch);
-  std::vector<float> next_count(current.pixel_count(), 0.0f);
-  const float* hist = usable ? value_.data() : nullptr;
-  const float* hcount = usable ? count_.data() : nullptr;
-  parallel_rows(0, h, nthreads, [&](int y) {
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(y) * w + x;
-      const float* c = current.pixel(x, y);
-      float* o = next.pixel(x, y);
-      bool finite = true;
-      for (int k = 0; k < ch; ++k) finite = finite && std::isfinite(c[k]);
-      float hv[8];
-      float n = 0;
-      bool have = false;
-      if (hist) {
-        auto valid = [&](std::size_t t) { return hcount[t] > 0.0f; };
-        if (r.sample(i, hist, ch, r.taps[i], hv, valid) > 0.0f) {
-          float cnt = 0;
-          r.sample(i, hcount, 1, r.taps[i], &cnt, valid);
-          n = std::max(1.0f, std::round(cnt));
-          have = true;
-        }
-      }
-      if (!finite) {
-        if (have) {
-          std::copy(hv, hv + ch, o);
-          next_count[i] = n;
-        }  // else: invalid, value 0, count 0
-        continue;
-      }
-      if (!have) {
-        std::copy(c, c + ch, o);
-        next_count[i] = 1.0f;
-        continue;
-      }
-      const double wn = std::max(1.0 / (double(n) + 1.0), alpha);
-      for (int k = 0; k < ch; ++k) o[k] = float((1.0 - wn) * hv[k] + wn * c[k]);
-      next_count[i] = std::min(n + 1.0f, 65535.0f);
-    }
-  });
-  value_ = std::move(next);
-  count_ = std::move(next_count);
+  begin(r, current);
+  parallel_rows(0, current.height(), nthreads, [&](int y) { row(y, r, current, alpha); });
+  finish();
   return value_;
 }
 
@@ -76,6 +115,22 @@ const Image& TemporalAccumulator::accumulate(const Frame& frame, const Image& co
   return accumulate(colour, pos, nrm, mp ? &mp->image : nullptr, nthreads);
 }
 
+const Image& TemporalAccumulator::accumulate(const Frame& frame, const Image& colour,
+                                             const std::function<void(int)>& before_row, int nthreads) {
+  const Image& pos = frame.image(Role::Position, Prefer::Geometry);
+  const Image& nrm = frame.image(Role::Normal, Prefer::Geometry);
+  const Pass* mp = frame.find(Role::Motion);
+  before_row_ = before_row ? &before_row : nullptr;
+  try {
+    const Image& out = accumulate(colour, pos, nrm, mp ? &mp->image : nullptr, nthreads);
+    before_row_ = nullptr;
+    return out;
+  } catch (...) {
+    before_row_ = nullptr;
+    throw;
+  }
+}
+
 const Image& TemporalAccumulator::accumulate(const Image& colour, const Image& position, const Image& normal,
                                              const Image* motion, int nthreads) {
   if (position.width() != colour.width() || position.height() != colour.height() ||
@@ -83,8 +138,27 @@ const Image& TemporalAccumulator::accumulate(const Image& colour, const Image& p
     throw Error(Errc::SizeMismatch, "accumulation: colour, position and normal differ in size");
   if (position.channels() < 3 || normal.channels() < 3)
     throw Error(Errc::InvalidArgument, "accumulation: position and normal need 3 channels");
-  reprojection_ = geometry_.update(position, normal, motion, params_.reprojection, nthreads);
-  return buffer_.accumulate(reprojection_, colour, params_.alpha, nthreads);
+  // Reprojection and accumulation fused: row y is blended right after its taps are
+  // decided (it reads only the previous frame's buffers). A camera cut is only known once
+  // every row is done; the blend is then redone without history.
+  Reprojection& r = reprojection_;
+  geometry_.begin(position, normal, motion, r);
+  buffer_.begin(r, colour);
+  const int h = colour.height();
+  row_lost_.assign(std::size_t(std::max(h, 0)), 0);
+  parallel_rows(0, h, nthreads, [&](int y) {
+    if (before_row_) (*before_row_)(y);
+    row_lost_[std::size_t(y)] = geometry_.row(y, position, normal, motion, params_.reprojection, r);
+    buffer_.row(y, r, colour, params_.alpha);
+  });
+  std::size_t lost = 0;
+  for (std::size_t v : row_lost_) lost += v;
+  if (geometry_.finish(params_.reprojection, r, lost)) {
+    buffer_.begin(r, colour);
+    parallel_rows(0, h, nthreads, [&](int y) { buffer_.row(y, r, colour, params_.alpha); });
+  }
+  buffer_.finish();
+  return buffer_.value();
 }
 
 }  // namespace mcr

@@ -9,6 +9,7 @@
 // Non-finite input: a pixel whose new value has a NaN/Inf channel keeps its history
 // (count unchanged); with no history it is marked invalid (count 0, value 0), and
 // invalid history taps are never read.
+#include <functional>
 #include <vector>
 
 #include "image/pass.h"
@@ -26,9 +27,20 @@ class AccumulationBuffer {
   const Image& value() const { return value_; }
   const std::vector<float>& count() const { return count_; }  // 0 = invalid pixel
 
+  // The same split up, for callers fusing it with other per-row work: begin() sizes the
+  // target (double-buffered, reused between frames) and says whether the history is
+  // usable with `r`; row(y) blends row y (r's row y must be final); finish() makes the
+  // target the new history. begin() may be called again before finish() to redo a frame.
+  void begin(const Reprojection& r, const Image& current);
+  void row(int y, const Reprojection& r, const Image& current, double alpha);
+  void finish();
+  // The target of the pending begin()/row() calls (the history-to-be).
+  const Image& pending() const { return next_; }
+
  private:
-  Image value_;
-  std::vector<float> count_;
+  Image value_, next_;
+  std::vector<float> count_, next_count_;
+  bool usable_ = false;
 };
 
 struct AccumulationParams {
@@ -50,6 +62,10 @@ class TemporalAccumulator {
   const Image& accumulate(const Frame& frame, const Image& colour, int nthreads = 0);
   const Image& accumulate(const Image& colour, const Image& position, const Image& normal, const Image* motion,
                           int nthreads = 0);
+  // Same, calling before_row(y) (when set) right before row y of `colour` is read, in
+  // the same parallel pass: lets a caller produce `colour` row by row (fused passes).
+  const Image& accumulate(const Frame& frame, const Image& colour, const std::function<void(int)>& before_row,
+                          int nthreads);
 
   const Reprojection& last_reprojection() const { return reprojection_; }
   const std::vector<float>& sample_count() const { return buffer_.count(); }
@@ -60,6 +76,8 @@ class TemporalAccumulator {
   GeometryHistory geometry_;
   AccumulationBuffer buffer_;
   Reprojection reprojection_;
+  std::vector<std::size_t> row_lost_;
+  const std::function<void(int)>* before_row_ = nullptr;
 };
 
 }  // namespace mcr

@@ -19,113 +19,181 @@ double dist2(const float* a, const float* b) {
 
 double norm2(const float* a) { return double(a[0]) * a[0] + double(a[1]) * a[1] + double(a[2]) * a[2]; }
 
-// Squared world size of pixel (x, y): the larger of the horizontal and vertical distance
-// to the nearer neighbour (the nearer one is on the same surface away from edges).
-double footprint2(const Image& pos, int x, int y) {
-  const float* p = pos.pixel(x, y);
-  auto nearest = [&](int ax, int ay, int bx, int by) {
-    double d = INFINITY;
-    if (ax >= 0 && ay >= 0 && ax < pos.width() && ay < pos.height() && finite3(pos.pixel(ax, ay)))
-      d = std::min(d, dist2(p, pos.pixel(ax, ay)));
-    if (bx >= 0 && by >= 0 && bx < pos.width() && by < pos.height() && finite3(pos.pixel(bx, by)))
-      d = std::min(d, dist2(p, pos.pixel(bx, by)));
-    return d;
-  };
-  const double h = nearest(x - 1, y, x + 1, y), v = nearest(x, y - 1, x, y + 1);
-  double f = 0;
-  if (std::isfinite(h)) f = std::max(f, h);
-  if (std::isfinite(v)) f = std::max(f, v);
-  return f;
-}
-
 }  // namespace
 
 void GeometryHistory::reset() {
   position_ = Image();
   normal_ = Image();
+  next_position_ = Image();
+  next_normal_ = Image();
 }
 
-Reprojection GeometryHistory::update(const Image& position, const Image& normal, const Image* motion,
-                                     const ReprojectionParams& params, int nthreads) {
-  Reprojection r;
+namespace {
+void ensure(Image& im, int w, int h, int ch) {
+  if (im.width() != w || im.height() != h || im.channels() != ch) im = Image(w, h, ch);
+}
+}  // namespace
+
+void GeometryHistory::begin(const Image& position, const Image& normal, const Image*& motion, Reprojection& r) {
+  (void)normal;
   const int w = position.width(), h = position.height();
   r.width = w;
   r.height = h;
   const std::size_t n = position.pixel_count();
-  r.prev_x.assign(n, 0.0f);
-  r.prev_y.assign(n, 0.0f);
-  r.taps.assign(n, 0);
-  r.inside.assign(n, 0);
+  // resize() keeps the storage of the previous frame: every entry is rewritten by row().
+  r.prev_x.resize(n);
+  r.prev_y.resize(n);
+  r.taps.resize(n);
+  r.inside.resize(n);
   r.has_history = !position_.empty() && position_.width() == w && position_.height() == h;
+  r.cut = false;
+  r.discarded = 0;
   if (motion && (motion->width() != w || motion->height() != h || motion->channels() < 2)) motion = nullptr;
+  ensure(next_position_, w, h, 3);
+  ensure(next_normal_, w, h, 3);
+}
 
-  std::vector<std::size_t> row_discarded(std::size_t(std::max(h, 0)), 0);
-  parallel_rows(0, h, nthreads, [&](int y) {
-    std::size_t lost = 0;
-    for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(y) * w + x;
-      float px, py;
-      previous_position(motion, x, y, px, py);
-      if (!std::isfinite(px) || !std::isfinite(py) || std::fabs(px) > 1e7f || std::fabs(py) > 1e7f) {
-        px = -2.0f;  // far outside: no tap
-        py = -2.0f;
+std::size_t GeometryHistory::row(int y, const Image& position, const Image& normal, const Image* motion,
+                                 const ReprojectionParams& params, Reprojection& r) {
+  const int w = r.width, h = r.height;
+  const int pc_ch = position.channels(), nc_ch = normal.channels();
+  const float* prow = position.data() + std::size_t(y) * w * pc_ch;
+  const float* nrow = normal.data() + std::size_t(y) * w * nc_ch;
+  // Keep this row of the current geometry for the next frame.
+  {
+    float* dp = next_position_.data() + std::size_t(y) * w * 3;
+    float* dn = next_normal_.data() + std::size_t(y) * w * 3;
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        dp[x * 3 + c] = prow[std::size_t(x) * pc_ch + c];
+        dn[x * 3 + c] = nrow[std::size_t(x) * nc_ch + c];
       }
-      r.prev_x[i] = px;
-      r.prev_y[i] = py;
-      if (!r.has_history) {
-        ++lost;
-        continue;
-      }
-      const int x0 = int(std::floor(px)), y0 = int(std::floor(py));
-      const float* pc = position.pixel(x, y);
-      const float* nc = normal.pixel(x, y);
-      const bool pos_ok = finite3(pc);
-      const double ncl = finite3(nc) ? norm2(nc) : -1.0;  // squared length
-      // Squared distance limit.
-      double limit = params.position_threshold * params.position_threshold;
-      if (pos_ok && params.relative_position) limit *= footprint2(position, x, y);
-      if (pos_ok) {
-        const double floor = 1e-6 * (1.0 + std::sqrt(norm2(pc)));  // float rounding of the positions
-        limit = std::max(limit, floor * floor);
-      }
-      const double cs = params.normal_cos;
-      std::uint8_t mask = 0, in = 0;
-      for (int k = 0; k < 4; ++k) {
-        const int tx = x0 + (k & 1), ty = y0 + (k >> 1);
-        if (tx < 0 || ty < 0 || tx >= w || ty >= h) continue;
-        in |= std::uint8_t(1u << k);
-        if (!pos_ok || ncl < 0) continue;
-        const float* pp = position_.pixel(tx, ty);
-        const float* np = normal_.pixel(tx, ty);
-        if (!finite3(pp) || !finite3(np)) continue;
-        if (!(dist2(pc, pp) <= limit)) continue;
-        const double npl = norm2(np);
-        if (ncl < 1e-6 && npl < 1e-6) {
-          // both background / no normal: agree
-        } else {
-          if (ncl < 1e-6 || npl < 1e-6) continue;
-          // cos >= cs without square roots: d >= cs |a||b|.
-          const double d = double(nc[0]) * np[0] + double(nc[1]) * np[1] + double(nc[2]) * np[2];
-          const double ab = ncl * npl;
-          const bool ok = cs >= 0 ? (d >= 0 && d * d >= cs * cs * ab) : (d >= 0 || d * d <= cs * cs * ab);
-          if (!ok) continue;
-        }
-        mask |= std::uint8_t(1u << k);
-      }
-      r.taps[i] = mask;
-      r.inside[i] = in;
-      if (!mask) ++lost;
+  }
+  const float* mrow = motion ? motion->data() + std::size_t(y) * w * motion->channels() : nullptr;
+  const int mch = motion ? motion->channels() : 0;
+  const float* hp = position_.data();
+  const float* hn = normal_.data();
+  // Float arithmetic on differences: the tests compare distances of neighbouring
+  // surface points, where float is ample; overflowing magnitudes read as "far".
+  const float thr2 = float(params.position_threshold * params.position_threshold);
+  const float cs = float(params.normal_cos), cs2 = cs * cs;
+  const bool relative = params.relative_position;
+  // x - x is 0 for finite x, NaN otherwise.
+  auto fin3 = [](const float* p) { return ((p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2])) == 0.0f; };
+  auto d2 = [](const float* a, const float* b) {
+    const float dx = a[0] - b[0], dy = a[1] - b[1], dz = a[2] - b[2];
+    return dx * dx + dy * dy + dz * dz;
+  };
+  const std::size_t rs = std::size_t(w) * std::size_t(pc_ch);
+  std::size_t lost = 0;
+  for (int x = 0; x < w; ++x) {
+    const std::size_t i = std::size_t(y) * w + x;
+    float px = float(x), py = float(y);
+    if (mrow) {
+      px += mrow[std::size_t(x) * mch];
+      py -= mrow[std::size_t(x) * mch + 1];
     }
-    row_discarded[std::size_t(y)] = lost;
-  });
-  for (std::size_t v : row_discarded) r.discarded += v;
+    if (!(std::fabs(px) <= 1e7f) || !(std::fabs(py) <= 1e7f)) {  // also NaN
+      px = -2.0f;  // far outside: no tap
+      py = -2.0f;
+    }
+    r.prev_x[i] = px;
+    r.prev_y[i] = py;
+    if (!r.has_history) {
+      r.taps[i] = 0;
+      r.inside[i] = 0;
+      ++lost;
+      continue;
+    }
+    const int x0 = floor_int(px), y0 = floor_int(py);
+    std::uint8_t in = 0;
+    for (int k = 0; k < 4; ++k) {
+      const int tx = x0 + (k & 1), ty = y0 + (k >> 1);
+      if (tx >= 0 && ty >= 0 && tx < w && ty < h) in |= std::uint8_t(1u << k);
+    }
+    r.inside[i] = in;
+    const float* pc = prow + std::size_t(x) * pc_ch;
+    const float* nc = nrow + std::size_t(x) * nc_ch;
+    if (!in || !fin3(pc) || !fin3(nc)) {
+      r.taps[i] = 0;
+      ++lost;
+      continue;
+    }
+    const float ncl = nc[0] * nc[0] + nc[1] * nc[1] + nc[2] * nc[2];  // squared length
+    // Squared distance limit.
+    float limit = thr2;
+    if (relative) {
+      // Footprint: the larger of the horizontal and vertical distance to the nearer
+      // finite neighbour.
+      float fh = INFINITY, fv = INFINITY;
+      if (x > 0 && fin3(pc - pc_ch)) fh = d2(pc, pc - pc_ch);
+      if (x + 1 < w && fin3(pc + pc_ch)) fh = std::min(fh, d2(pc, pc + pc_ch));
+      if (y > 0 && fin3(pc - rs)) fv = d2(pc, pc - rs);
+      if (y + 1 < h && fin3(pc + rs)) fv = std::min(fv, d2(pc, pc + rs));
+      float f = 0;
+      if (fh < INFINITY) f = std::max(f, fh);
+      if (fv < INFINITY) f = std::max(f, fv);
+      limit *= f;
+    }
+    {
+      const float floor = 1e-6f * (1.0f + std::sqrt(pc[0] * pc[0] + pc[1] * pc[1] + pc[2] * pc[2]));  // float rounding
+      limit = std::max(limit, floor * floor);
+    }
+    std::uint8_t mask = 0;
+    for (int k = 0; k < 4; ++k) {
+      if (!(in & (1u << k))) continue;
+      const std::size_t t = (std::size_t(y0 + (k >> 1)) * w + std::size_t(x0 + (k & 1))) * 3;
+      const float* pp = hp + t;
+      const float* np = hn + t;
+      if (!fin3(pp) || !fin3(np)) continue;
+      if (!(d2(pc, pp) <= limit)) continue;
+      const float npl = np[0] * np[0] + np[1] * np[1] + np[2] * np[2];
+      if (ncl < 1e-6f && npl < 1e-6f) {
+        // both background / no normal: agree
+      } else {
+        if (ncl < 1e-6f || npl < 1e-6f) continue;
+        // cos >= cs without square roots: d >= cs |a||b|.
+        const float d = nc[0] * np[0] + nc[1] * np[1] + nc[2] * np[2];
+        const float ab = ncl * npl;
+        const bool ok = cs >= 0 ? (d >= 0 && d * d >= cs2 * ab) : (d >= 0 || d * d <= cs2 * ab);
+        if (!ok) continue;
+      }
+      mask |= std::uint8_t(1u << k);
+    }
+    r.taps[i] = mask;
+    if (!mask) ++lost;
+  }
+  return lost;
+}
+
+bool GeometryHistory::finish(const ReprojectionParams& params, Reprojection& r, std::size_t discarded) {
+  const std::size_t n = std::size_t(r.width) * std::size_t(r.height);
+  r.discarded = discarded;
   if (r.has_history && n > 0 && double(r.discarded) > params.cut_fraction * double(n)) {
     r.cut = true;
     std::fill(r.taps.begin(), r.taps.end(), 0);
     std::fill(r.inside.begin(), r.inside.end(), 0);
   }
-  position_ = position.channels() == 3 ? position : position.channel_range(0, 3);
-  normal_ = normal.channels() == 3 ? normal : normal.channel_range(0, 3);
+  std::swap(position_, next_position_);
+  std::swap(normal_, next_normal_);
+  return r.cut;
+}
+
+void GeometryHistory::update(const Image& position, const Image& normal, const Image* motion,
+                             const ReprojectionParams& params, int nthreads, Reprojection& r) {
+  begin(position, normal, motion, r);
+  const int h = position.height();
+  std::vector<std::size_t> row_discarded(std::size_t(std::max(h, 0)), 0);
+  parallel_rows(0, h, nthreads, [&](int y) { row_discarded[std::size_t(y)] = row(y, position, normal, motion, params, r); });
+  std::size_t d = 0;
+  for (std::size_t v : row_discarded) d += v;
+  finish(params, r, d);
+}
+
+Reprojection GeometryHistory::update(const Image& position, const Image& normal, const Image* motion,
+                                     const ReprojectionParams& params, int nthreads) {
+  Reprojection r;
+  update(position, normal, motion, params, nthreads, r);
   return r;
 }
 

@@ -62,12 +62,34 @@ class GeometryHistory {
   // nullptr for zero motion. All the same size. A size change drops the history.
   Reprojection update(const Image& position, const Image& normal, const Image* motion,
                       const ReprojectionParams& params, int nthreads);
+  // Same, into `r` (its buffers are reused from frame to frame: no allocation once sized).
+  void update(const Image& position, const Image& normal, const Image* motion, const ReprojectionParams& params,
+              int nthreads, Reprojection& r);
   void reset();
   bool empty() const { return position_.empty(); }
 
+  // The same update split up so that a caller can fuse its own per-row work with it
+  // (TemporalAccumulator does the accumulation of row y right after its reprojection):
+  // begin() sizes `r`; row(y) fills row y of `r` and stores row y of the current
+  // geometry as the next history (returns the pixels of the row with no kept tap);
+  // finish() decides the camera cut (then every tap is cleared; returns true) and makes
+  // the stored geometry the history. Rows may run in parallel between begin and finish.
+  void begin(const Image& position, const Image& normal, const Image*& motion, Reprojection& r);
+  std::size_t row(int y, const Image& position, const Image& normal, const Image* motion,
+                  const ReprojectionParams& params, Reprojection& r);
+  bool finish(const ReprojectionParams& params, Reprojection& r, std::size_t discarded);
+
  private:
-  Image position_, normal_;
+  Image position_, normal_;   // previous frame (3 channels)
+  Image next_position_, next_normal_;  // current frame, filled by row()
 };
+
+// floor() as an int for |v| < 2^31 (reprojected positions are kept within +-1e7): inline
+// code instead of a libm call on the baseline x86-64 target.
+inline int floor_int(float v) {
+  const int i = int(v);
+  return i - (float(i) > v ? 1 : 0);
+}
 
 // The previous-frame position of pixel (x, y) for a motion pass (or nullptr).
 inline void previous_position(const Image* motion, int x, int y, float& px, float& py) {
@@ -84,8 +106,8 @@ float Reprojection::sample(std::size_t i, const float* history, int channels, st
                            Accept&& accept) const {
   if (!mask) return 0.0f;
   const float px = prev_x[i], py = prev_y[i];
-  const float fx0 = std::floor(px), fy0 = std::floor(py);
-  const int x0 = int(fx0), y0 = int(fy0);
+  const int x0 = floor_int(px), y0 = floor_int(py);
+  const float fx0 = float(x0), fy0 = float(y0);
   const float fx = px - fx0, fy = py - fy0;
   const float w[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
   const int tx[4] = {x0, x0 + 1, x0, x0 + 1}, ty[4] = {y0, y0, y0 + 1, y0 + 1};
