@@ -14,89 +14,17 @@
 
 #include "filters/feature_weights.h"
 #include "filters/foveation.h"
+#include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
 
 namespace mcr {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-const char* kFeatureNames[5] = {"colour", "normal", "position", "albedo", "depth"};
-const Role kFeatureRoles[5] = {Role::Colour, Role::Normal, Role::Position, Role::Albedo, Role::Depth};
-
-using Params = std::map<std::string, ParamValue>;
-
-Image random_image(int w, int h, int ch, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> dist(lo, hi);
-  Image im(w, h, ch);
-  for (float& v : im.storage()) v = dist(rng);
-  return im;
-}
-
-void add_pass(Frame& f, Role role, Image im) {
-  Pass p;
-  p.role = role;
-  p.name = role_name(role);
-  p.image = std::move(im);
-  f.passes.push_back(std::move(p));
-}
-
-Frame colour_frame(const Image& colour) {
-  Frame f;
-  f.width = colour.width();
-  f.height = colour.height();
-  f.path = "test.exr";
-  add_pass(f, Role::Colour, colour);
-  return f;
-}
-
-// Colour plus every feature, random.
-Frame full_frame(int w, int h, unsigned seed) {
-  Frame f = colour_frame(random_image(w, h, 3, seed));
-  add_pass(f, Role::Normal, random_image(w, h, 3, seed + 1, -1.0f, 1.0f));
-  add_pass(f, Role::Position, random_image(w, h, 3, seed + 2, 0.0f, 2.0f));
-  add_pass(f, Role::Albedo, random_image(w, h, 3, seed + 3, 0.1f, 1.0f));
-  add_pass(f, Role::Depth, random_image(w, h, 1, seed + 4, 1.0f, 3.0f));
-  return f;
-}
-
-Image& pass_image(Frame& f, Role r) {
-  for (Pass& p : f.passes)
-    if (p.role == r) return p.image;
-  throw std::runtime_error("no pass");
-}
-
-struct Result {
-  Image out;
-  std::size_t repaired = 0;
-  std::vector<std::string> notes;
-};
+using namespace testutil;
 
 Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi roi = {}) {
-  BilateralFilter f;
-  for (const auto& [k, v] : params) f.set(k, v);
-  f.commit();
-  ExecOptions eo;
-  eo.nthreads = nthreads;
-  eo.roi = roi;
-  Result r;
-  r.out = f.execute(frame, eo);
-  r.repaired = f.nonfinite_repaired();
-  r.notes = f.notes();
-  return r;
-}
-
-Params all_off() {
-  Params p;
-  for (const char* n : kFeatureNames) p[std::string("use_") + n] = std::string("off");
-  return p;
-}
-
-Params with(Params p, const Params& more) {
-  for (const auto& [k, v] : more) p[k] = v;
-  return p;
+  return run_filter<BilateralFilter>(frame, params, nthreads, roi);
 }
 
 // Sigmas wide enough that random features still let neighbours mix (the
