@@ -127,10 +127,7 @@ void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& ro
   pass.s = s.empty() ? nullptr : s.data();
   pass.s_const = coef(spatial.inner);
   pass.radius = rad.empty() ? nullptr : rad.data();
-  for (int k = -rmax; k <= rmax; ++k) {
-    pass.off.push_back(k);
-    pass.h.push_back(1.0f);
-  }
+  pass.set_dense_taps(rmax);
   for (int c = 0; c < 3; ++c) pass.out[c] = res[c].data();
   cross_filter(pass, roi, nthreads);
   const float* planes[3] = {res[0].data(), res[1].data(), res[2].data()};

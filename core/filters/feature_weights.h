@@ -135,6 +135,17 @@ struct CrossPass {
   std::vector<float> h;              // 1D tap weights; the tap weight is h[i] * h[j]
   float* out[3] = {nullptr, nullptr, nullptr};
   float* out_ok = nullptr;           // optional: 1 where the result holds data
+
+  // Unit-weight taps at every offset in [-rmax, rmax] (the dense kernels of
+  // gaussian and bilateral; the spatial weight comes from s).
+  void set_dense_taps(int rmax) {
+    off.clear();
+    h.clear();
+    for (int k = -rmax; k <= rmax; ++k) {
+      off.push_back(k);
+      h.push_back(1.0f);
+    }
+  }
 };
 // For every pixel p of `region` (inside pb.box): sum w(p,q) c(q) / sum w(p,q) over the
 // taps inside the image (clipped and renormalised at the borders). A pixel whose

@@ -1,5 +1,5 @@
 #pragma once
-// Shared by the feature-filter tests (bilateral, atrous): random frames with
+// Shared by the image-filter tests (gaussian, bilateral, atrous): random frames with
 // every feature pass, and a one-call run of a filter with a parameter map.
 #include <gtest/gtest.h>
 

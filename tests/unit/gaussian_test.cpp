@@ -13,56 +13,26 @@
 
 #include "filters/feature_weights.h"
 #include "filters/foveation.h"
+#include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
 
 namespace mcr {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+using testutil::kInf;
+using testutil::kNaN;
+using testutil::Params;
+using testutil::Result;
 
-using Params = std::map<std::string, ParamValue>;
-
-Frame frame_of(const Image& colour) {
-  Frame f;
-  f.width = colour.width();
-  f.height = colour.height();
-  f.path = "test.exr";
-  Pass p;
-  p.role = Role::Colour;
-  p.name = "Combined";
-  p.image = colour;
-  f.passes.push_back(p);
-  return f;
-}
+Frame frame_of(const Image& colour) { return testutil::colour_frame(colour); }
 
 Image random_image(int w, int h, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> dist(lo, hi);
-  Image im(w, h, 3);
-  for (float& v : im.storage()) v = dist(rng);
-  return im;
+  return testutil::random_image(w, h, 3, seed, lo, hi);
 }
 
-struct Result {
-  Image out;
-  std::size_t repaired = 0;
-  std::vector<std::string> notes;
-};
-
 Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi roi = {}) {
-  GaussianFilter f;
-  for (const auto& [k, v] : params) f.set(k, v);
-  f.commit();
-  ExecOptions eo;
-  eo.nthreads = nthreads;
-  eo.roi = roi;
-  Result r;
-  r.out = f.execute(frame, eo);
-  r.repaired = f.nonfinite_repaired();
-  r.notes = f.notes();
-  return r;
+  return testutil::run_filter<GaussianFilter>(frame, params, nthreads, roi);
 }
 
 Image run_gauss(const Image& colour, double sigma, int nthreads = 0, Roi roi = {}) {
