@@ -120,10 +120,10 @@ int run_denoise(const DenoiseArgs& a) {
     if (!out.empty()) {
       t0 = clock::now();
       WriteOptions w = wo;
-      w.attributes.emplace_back("mcrecon:filter", session.filter().info().name);
+      w.attributes.emplace_back("mcreconFilter", session.filter().info().name);
       std::string params = "accumulate=true";
       for (const auto& kv : session.filter().params().values()) params += " " + kv.first + "=" + param_value_text(kv.second);
-      w.attributes.emplace_back("mcrecon:parameters", params);
+      w.attributes.emplace_back("mcreconParameters", params);
       write_result(out, result, frame, w);
       t.write_ms = ms(t0);
     }

@@ -135,7 +135,7 @@ class McreconInput final : public ImageInput {
   // Always succeeds for a name of ours. oiiotool answers a failed open of a name
   // that is not a file on disk ("x.exr.mcrecon?...") with its own "File does not
   // exist", hiding our message; so errors found here are kept and reported by the
-  // first pixel read (and shown as the "mcrecon:error" attribute), and the spec
+  // first pixel read (and shown as the "mcreconError" attribute), and the spec
   // of a source that cannot be read is a 1x1 placeholder.
   bool open(const std::string& name, ImageSpec& newspec, const ImageSpec& config) override {
     if (!mp::is_plugin_name(name)) return false;  // foreign: before any OIIO call (2.4 deadlock)
@@ -164,11 +164,11 @@ class McreconInput final : public ImageInput {
     m_spec.alpha_channel = 3;
     m_spec.attribute("Software", "mcrecon");
     if (deferred_error_.empty()) {
-      m_spec.attribute("mcrecon:filter", request_.filter);
-      m_spec.attribute("mcrecon:parameters", params_text);
-      m_spec.attribute("mcrecon:source", request_.source);
+      m_spec.attribute("mcreconFilter", request_.filter);
+      m_spec.attribute("mcreconParameters", params_text);
+      m_spec.attribute("mcreconSource", request_.source);
     } else {
-      m_spec.attribute("mcrecon:error", deferred_error_);
+      m_spec.attribute("mcreconError", deferred_error_);
     }
     newspec = m_spec;
     open_ = true;
@@ -355,8 +355,8 @@ class McreconOutput final : public ImageOutput {
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;
       wo.compression = request_.compression;
-      wo.attributes.emplace_back("mcrecon:filter", request_.filter);
-      wo.attributes.emplace_back("mcrecon:parameters", params_text_);
+      wo.attributes.emplace_back("mcreconFilter", request_.filter);
+      wo.attributes.emplace_back("mcreconParameters", params_text_);
       mcr::write_result(name_, rgb, frame, wo);
       ok_ = true;
     } catch (const std::exception& e) {

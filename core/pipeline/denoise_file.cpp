@@ -53,8 +53,8 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
   if (!output.empty()) {
     t0 = std::chrono::steady_clock::now();
     WriteOptions w = write;
-    w.attributes.emplace_back("mcrecon:filter", filter_->info().name);
-    w.attributes.emplace_back("mcrecon:parameters", parameters_text(*filter_));
+    w.attributes.emplace_back("mcreconFilter", filter_->info().name);
+    w.attributes.emplace_back("mcreconParameters", parameters_text(*filter_));
     write_result(output, result, frame, w);
     t.write_ms = ms_since(t0);
   }

@@ -41,7 +41,7 @@ std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
                                               const std::vector<std::pair<std::string, std::string>>& params);
 
 // "radius=3 demodulate=false ...": every parameter value of the filter, as the
-// "mcrecon:parameters" header attribute of an output.
+// "mcreconParameters" header attribute of an output.
 std::string parameters_text(const Filter& filter);
 
 // "key=value" -> pair; throws InvalidArgument.

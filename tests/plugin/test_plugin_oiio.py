@@ -111,12 +111,12 @@ class TestDiscovery(PluginTestBase):
             self.assertNotEqual(proc.returncode, 0, name)
             self.assertIn("error", (proc.stdout + proc.stderr).lower())
         # Our own name on a corrupt source: fast too; --info reads no pixels, so the error is
-        # the mcrecon:error attribute there, and a read fails with it.
+        # the mcreconError attribute there, and a read fails with it.
         try:
             proc = oiiotool("--info", "-v", bad + ".mcrecon?filter=box", timeout=10)
         except subprocess.TimeoutExpired:
             self.fail("oiiotool --info on a .mcrecon name of a corrupt EXR hung (> 10 s)")
-        self.assertIn("mcrecon:error", proc.stdout)
+        self.assertIn("mcreconError", proc.stdout)
         try:
             proc = oiiotool(bad + ".mcrecon?filter=box", "-o", self.path("o.exr"), timeout=10)
         except subprocess.TimeoutExpired:
@@ -154,6 +154,22 @@ class TestMatchesCli(PluginTestBase):
                     self.assertEqual(list(inp.spec().channelnames), RGBA)
                 finally:
                     inp.close()
+
+    def test_output_metadata_survives_a_copy_with_the_plugin_loaded(self):
+        # OIIO drops "<format>:" attributes of a known format when writing another one, so
+        # with the plugin loaded a "mcrecon:" prefix would vanish in `oiiotool in -o out`.
+        den = self.path("den.exr")
+        tu.run_cli("denoise", ROOM, "-o", den, "-f", "box", "--set", "radius=1")
+        for src, what in ((den, "CLI output"), (ROOM + ".mcrecon?filter=box&radius=1", "plugin read")):
+            with self.subTest(source=what):
+                copy = self.path("copy.exr")
+                check_ok(oiiotool(src, "-o", copy))
+                spec = oiio.ImageInput.open(copy)
+                try:
+                    self.assertEqual(spec.spec().get_string_attribute("mcreconFilter"), "box")
+                    self.assertIn("radius=1", spec.spec().get_string_attribute("mcreconParameters"))
+                finally:
+                    spec.close()
 
     def test_parameters_and_pass_overrides_in_all_three_styles(self):
         want = self.path("cli.exr")
@@ -254,9 +270,9 @@ class TestErrors(PluginTestBase):
         line = self.expect_cli_message(["-f", "nosuchfilter"],
                                        ROOM + ".mcrecon?filter=nosuchfilter", "-o", self.path("o.exr"))
         self.assertIn("nosuchfilter", line)
-        # --info reads no pixels: the error is in the header as mcrecon:error.
+        # --info reads no pixels: the error is in the header as mcreconError.
         proc = oiiotool("--info", "-v", ROOM + ".mcrecon?filter=nosuchfilter", timeout=60)
-        self.assertIn("mcrecon:error", proc.stdout)
+        self.assertIn("mcreconError", proc.stdout)
         self.assertIn(line, proc.stdout)
 
     def test_unknown_parameter_in_every_style(self):
@@ -323,7 +339,7 @@ class TestPythonModule(PluginTestBase):
             spec = inp.spec()
             self.assertEqual(inp.format_name(), "mcrecon")
             self.assertEqual(list(spec.channelnames), RGBA)
-            self.assertEqual(spec.getattribute("mcrecon:filter"), "box")
+            self.assertEqual(spec.getattribute("mcreconFilter"), "box")
             pixels = inp.read_image(0, 0, 0, 4, "float")
         finally:
             inp.close()
@@ -337,7 +353,7 @@ class TestPythonModule(PluginTestBase):
         bad = oiio.ImageInput.open(ROOM + ".mcrecon?filter=box&radius=99999")
         self.assertIsNotNone(bad, oiio.geterror())
         try:
-            self.assertIn("radius", bad.spec().getattribute("mcrecon:error"))
+            self.assertIn("radius", bad.spec().getattribute("mcreconError"))
             self.assertIsNone(bad.read_image(0, 0, 0, 4, "float"))
             self.assertIn("parameter 'radius' of filter 'box'", bad.geterror())
         finally:

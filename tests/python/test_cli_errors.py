@@ -369,7 +369,7 @@ class CliDenoiseTest(_TempDirCase):
         want = numpy_box(self.ml_pixels[:, :, 0:3], 1)
         np.testing.assert_allclose(px[:, :, :3], want, rtol=1e-6, atol=0)
         np.testing.assert_array_equal(px[:, :, 3], self.ml_pixels[:, :, 3])
-        self.assertEqual(spec.get_string_attribute("mcrecon:filter"), "box")
+        self.assertEqual(spec.get_string_attribute("mcreconFilter"), "box")
 
     def test_radius_zero_is_identity(self):
         out = os.path.join(self.out, "same.exr")

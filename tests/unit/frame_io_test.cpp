@@ -356,7 +356,7 @@ TEST_F(FrameIoTest, WriteResultThenReadFrameRoundTrips) {
     for (int x = 0; x < 5; ++x)
       for (int c = 0; c < 3; ++c) result.at(x, y, c) = 0.5f + float(x * 7 + y * 3 + c);
   WriteOptions wo;
-  wo.attributes.emplace_back("mcrecon:filter", "box");
+  wo.attributes.emplace_back("mcreconFilter", "box");
   write_result(path("out.exr"), result, in, wo);
   EXPECT_EQ(listing(), (Names{"in.exr", "out.exr"}));  // no temp file left
 
@@ -371,7 +371,7 @@ TEST_F(FrameIoTest, WriteResultThenReadFrameRoundTrips) {
   auto spec_in = OIIO::ImageInput::open(path("out.exr"));
   ASSERT_TRUE(spec_in);
   EXPECT_EQ(spec_in->spec().format, OIIO::TypeFloat);
-  EXPECT_EQ(spec_in->spec().get_string_attribute("mcrecon:filter"), "box");
+  EXPECT_EQ(spec_in->spec().get_string_attribute("mcreconFilter"), "box");
 }
 
 TEST_F(FrameIoTest, WriteResultWithoutAlphaWritesOne) {
