@@ -141,6 +141,7 @@ class McreconInput final : public ImageInput {
     if (!mp::is_plugin_name(name)) return false;  // foreign: before any OIIO call (2.4 deadlock)
     close();
     int width = 1, height = 1;
+    mcr::PixelWindow window;
     std::string params_text;
     try {
       auto [source, query] = mp::split_name(name);
@@ -155,11 +156,21 @@ class McreconInput final : public ImageInput {
       const ImageSpec src = source_header(source);
       width = src.width;
       height = src.height;
+      window = {src.x, src.y, src.full_x, src.full_y, src.full_width, src.full_height};
     } catch (const std::exception& e) {
       deferred_error_ = message(e);
     }
     // The layout write_result gives `mcrecon denoise` output: R,G,B,A float.
     m_spec = ImageSpec(width, height, 4, TypeFloat);
+    // The source's data and display windows, as `mcrecon denoise` writes them.
+    m_spec.x = window.x;
+    m_spec.y = window.y;
+    if (window.full_width > 0 && window.full_height > 0) {
+      m_spec.full_x = window.full_x;
+      m_spec.full_y = window.full_y;
+      m_spec.full_width = window.full_width;
+      m_spec.full_height = window.full_height;
+    }
     m_spec.channelnames = {"R", "G", "B", "A"};
     m_spec.alpha_channel = 3;
     m_spec.attribute("Software", "mcrecon");
@@ -187,7 +198,8 @@ class McreconInput final : public ImageInput {
   }
 
   bool read_native_scanlines(int subimage, int miplevel, int ybegin, int yend, int /*z*/, void* data) override {
-    if (!open_ || subimage != 0 || miplevel != 0 || ybegin < 0 || yend > m_spec.height || ybegin > yend) {
+    if (!open_ || subimage != 0 || miplevel != 0 || ybegin < m_spec.y || yend > m_spec.y + m_spec.height ||
+        ybegin > yend) {
       errorfmt("mcrecon: no scanlines {}-{} in subimage {} MIP level {}", ybegin, yend, subimage, miplevel);
       return false;
     }
@@ -197,7 +209,8 @@ class McreconInput final : public ImageInput {
     }
     if (!ensure_result()) return false;
     const std::size_t row = std::size_t(m_spec.width) * 4;
-    std::memcpy(data, result_->rgba.data() + std::size_t(ybegin) * row, std::size_t(yend - ybegin) * row * sizeof(float));
+    std::memcpy(data, result_->rgba.data() + std::size_t(ybegin - m_spec.y) * row,
+                std::size_t(yend - ybegin) * row * sizeof(float));
     return true;
   }
 
@@ -276,8 +289,11 @@ class McreconOutput final : public ImageOutput {
   ~McreconOutput() override { close(); }
   const char* format_name() const override { return mp::kFormat; }
   int supports(string_view feature) const override {
+    // origin/displaywindow: the EXR we write keeps data and display windows, so a
+    // crop is not padded out to its display window on the way in.
     return feature == "nchannels" || feature == "alpha" || feature == "random_access" ||
-           feature == "arbitrary_metadata";
+           feature == "arbitrary_metadata" || feature == "origin" || feature == "negativeorigin" ||
+           feature == "displaywindow";
   }
 
   bool open(const std::string& name, const ImageSpec& spec, OpenMode mode = Create) override {
@@ -349,8 +365,9 @@ class McreconOutput final : public ImageOutput {
     try {
       std::lock_guard<std::mutex> run(g_run_mutex);
       std::vector<std::string> names(m_spec.channelnames.begin(), m_spec.channelnames.end());
-      const mcr::Frame frame = mcr::frame_from_channels(shown_name_, m_spec.width, m_spec.height, names,
-                                                        std::move(pixels_), request_.read);
+      mcr::Frame frame = mcr::frame_from_channels(shown_name_, m_spec.width, m_spec.height, names,
+                                                  std::move(pixels_), request_.read);
+      frame.window = {m_spec.x, m_spec.y, m_spec.full_x, m_spec.full_y, m_spec.full_width, m_spec.full_height};
       const mcr::Image rgb = run_filter(request_, settings_, shown_name_, frame);
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;

@@ -52,6 +52,14 @@ struct Pass {
 // camera-space "Denoising Normal" and a world-space "Normal".
 enum class Prefer { Feature, Geometry };
 
+// Where the pixels sit: the OpenEXR data window's origin and the display window
+// (full_width 0 = the data window itself). Kept so that crops and overscan
+// survive a read-filter-write round trip.
+struct PixelWindow {
+  int x = 0, y = 0;
+  int full_x = 0, full_y = 0, full_width = 0, full_height = 0;
+};
+
 // One frame: colour plus feature passes, all the same size. A deep frame also
 // carries its per-sample buffer; `colour` then holds the flattened image.
 class Frame {
@@ -61,6 +69,7 @@ class Frame {
   std::string layer;  // chosen view layer ("" for plain files)
   std::vector<std::string> layers;  // every layer in the file
   int frame_number = 0;
+  PixelWindow window;
   std::vector<Pass> passes;
   std::vector<Pass> extra;  // channels with no role, carried by --keep-passes
   std::shared_ptr<const DeepSamples> deep;

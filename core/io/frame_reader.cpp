@@ -19,9 +19,10 @@ using namespace OIIO;
 
 namespace {
 
-// All channels of subimage 0 as interleaved float.
+// All channels of every part (subimage) as interleaved float.
 struct RawImage {
   int width = 0, height = 0;
+  PixelWindow window;
   std::vector<std::string> names;
   std::vector<float> pixels;
   std::shared_ptr<DeepSamples> deep;
@@ -49,6 +50,82 @@ std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec
   return deep;
 }
 
+void check_spec(const ImageSpec& spec, const std::string& path) {
+  const double bytes = double(spec.width) * spec.height * std::max(spec.nchannels, 1) * 4.0;
+  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || bytes > 32e9)
+    throw Error(Errc::ReadFailed, "cannot read '" + path + "': implausible size " + std::to_string(spec.width) +
+                                      "x" + std::to_string(spec.height) + "x" + std::to_string(spec.nchannels));
+}
+
+PixelWindow window_of(const ImageSpec& spec) {
+  return {spec.x, spec.y, spec.full_x, spec.full_y, spec.full_width, spec.full_height};
+}
+
+std::string part_label(const ImageSpec& spec, int part) {
+  const std::string name = spec.get_string_attribute("name");
+  return "part " + std::to_string(part) + (name.empty() ? "" : " '" + name + "'");
+}
+
+void read_deep(RawImage& raw, const std::string& path) {
+  ImageBuf deepbuf(path);
+  if (!deepbuf.read(0, 0, true, TypeFloat) || !deepbuf.deep())
+    throw Error(Errc::ReadFailed, "cannot read deep pixels of '" + path + "': " + deepbuf.geterror());
+  raw.deep = copy_deep(*deepbuf.deepdata(), deepbuf.spec());
+  // Flat passes of a deep file: front-to-back composite of every channel.
+  ImageBuf flat = ImageBufAlgo::flatten(deepbuf);
+  if (flat.has_error()) throw Error(Errc::ReadFailed, "cannot flatten deep '" + path + "': " + flat.geterror());
+  raw.names.assign(flat.spec().channelnames.begin(), flat.spec().channelnames.end());
+  raw.pixels.resize(std::size_t(raw.width) * raw.height * flat.nchannels());
+  flat.get_pixels(flat.roi(), TypeFloat, raw.pixels.data());
+}
+
+// Every part of a multi-part file joins the channel list. A part's channel whose
+// name an earlier part already uses gets the part's name as a prefix
+// ("normal" part with R,G,B -> normal.R, ...), the OpenEXR multi-part convention.
+void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
+  std::vector<std::vector<float>> parts;
+  std::vector<int> widths;
+  for (int part = 0; in.seek_subimage(part, 0); ++part) {
+    const ImageSpec& spec = in.spec();
+    if (part > 0) {
+      if (spec.deep) continue;  // only part 0 may be deep (read as the per-sample buffer)
+      if (spec.width != raw.width || spec.height != raw.height || spec.x != raw.window.x || spec.y != raw.window.y)
+        throw Error(Errc::SizeMismatch, "'" + path + "' " + part_label(spec, part) + " has data window " +
+                                            std::to_string(spec.width) + "x" + std::to_string(spec.height) + " at (" +
+                                            std::to_string(spec.x) + "," + std::to_string(spec.y) + "), part 0 " +
+                                            std::to_string(raw.width) + "x" + std::to_string(raw.height) + " at (" +
+                                            std::to_string(raw.window.x) + "," + std::to_string(raw.window.y) + ")");
+      check_spec(spec, path);
+    }
+    const std::string part_name = spec.get_string_attribute("name");
+    for (const auto& n : spec.channelnames) {
+      const bool taken = std::find(raw.names.begin(), raw.names.end(), n) != raw.names.end();
+      if (taken && part_name.empty())
+        throw Error(Errc::ReadFailed, "'" + path + "' " + part_label(spec, part) + " repeats channel '" + n +
+                                          "' and has no part name to tell it apart");
+      raw.names.push_back(taken ? part_name + "." + n : n);
+    }
+    parts.emplace_back(std::size_t(spec.width) * spec.height * spec.nchannels);
+    widths.push_back(spec.nchannels);
+    if (!in.read_image(part, 0, 0, spec.nchannels, TypeFloat, parts.back().data()))
+      throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' " + part_label(spec, part) +
+                                        " (truncated or corrupt?): " + in.geterror());
+  }
+  if (parts.size() == 1) {
+    raw.pixels = std::move(parts.front());
+    return;
+  }
+  const std::size_t n = std::size_t(raw.width) * raw.height, total = raw.names.size();
+  raw.pixels.resize(n * total);
+  std::size_t first = 0;
+  for (std::size_t k = 0; k < parts.size(); ++k) {
+    const std::size_t nc = std::size_t(widths[k]);
+    for (std::size_t i = 0; i < n; ++i)
+      std::copy_n(parts[k].data() + i * nc, nc, raw.pixels.data() + i * total + first);
+    first += nc;
+  }
+}
+
 RawImage read_raw(const std::string& path) {
   check_path(path);
   auto in = ImageInput::open(path);
@@ -57,31 +134,17 @@ RawImage read_raw(const std::string& path) {
     throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
   }
   const ImageSpec spec = in->spec();
+  check_spec(spec, path);
   RawImage raw;
   raw.width = spec.width;
   raw.height = spec.height;
-  raw.names.assign(spec.channelnames.begin(), spec.channelnames.end());
-  const double bytes = double(spec.width) * spec.height * std::max(spec.nchannels, 1) * 4.0;
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || bytes > 32e9)
-    throw Error(Errc::ReadFailed, "cannot read '" + path + "': implausible size " + std::to_string(spec.width) +
-                                      "x" + std::to_string(spec.height) + "x" + std::to_string(spec.nchannels));
+  raw.window = window_of(spec);
   try {
     if (spec.deep) {
       in.reset();
-      ImageBuf deepbuf(path);
-      if (!deepbuf.read(0, 0, true, TypeFloat) || !deepbuf.deep())
-        throw Error(Errc::ReadFailed, "cannot read deep pixels of '" + path + "': " + deepbuf.geterror());
-      raw.deep = copy_deep(*deepbuf.deepdata(), deepbuf.spec());
-      // Flat passes of a deep file: front-to-back composite of every channel.
-      ImageBuf flat = ImageBufAlgo::flatten(deepbuf);
-      if (flat.has_error()) throw Error(Errc::ReadFailed, "cannot flatten deep '" + path + "': " + flat.geterror());
-      raw.names.assign(flat.spec().channelnames.begin(), flat.spec().channelnames.end());
-      raw.pixels.resize(std::size_t(spec.width) * spec.height * flat.nchannels());
-      flat.get_pixels(flat.roi(), TypeFloat, raw.pixels.data());
+      read_deep(raw, path);
     } else {
-      raw.pixels.resize(std::size_t(spec.width) * spec.height * spec.nchannels);
-      if (!in->read_image(0, 0, 0, spec.nchannels, TypeFloat, raw.pixels.data()))
-        throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' (truncated or corrupt?): " + in->geterror());
+      read_parts(*in, raw, path);
     }
   } catch (const std::bad_alloc&) {
     throw Error(Errc::ReadFailed, "cannot read '" + path + "': out of memory");
@@ -180,6 +243,7 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
   frame.width = raw.width;
   frame.height = raw.height;
   frame.path = path;
+  frame.window = raw.window;
   frame.deep = raw.deep;
 
   const auto groups = group_channels(raw.names);

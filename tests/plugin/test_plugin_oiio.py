@@ -171,6 +171,26 @@ class TestMatchesCli(PluginTestBase):
                 finally:
                     spec.close()
 
+    def test_cropped_input_keeps_its_data_window_in_every_front_end(self):
+        crop = self.path("crop.exr")  # 100x80 pixels at (20, 30) of the 256x192 display window
+        check_ok(oiiotool(ROOM, "--crop", "100x80+20+30", "-o", crop))
+        want = self.path("cli.exr")
+        tu.run_cli("denoise", crop, "-o", want, "-f", "box")
+        got_read = self.path("read.exr")
+        check_ok(oiiotool(crop + ".mcrecon?filter=box", "-o", got_read))
+        got_out = self.path("out.exr")
+        check_ok(oiiotool(crop, "--attrib", "mcrecon:filter", "box", "-o:fileformatname=mcrecon", got_out))
+        for path in (want, got_read, got_out):
+            inp = oiio.ImageInput.open(path)
+            try:
+                s = inp.spec()
+                self.assertEqual((s.x, s.y, s.width, s.height), (20, 30, 100, 80), path)
+                self.assertEqual((s.full_x, s.full_y, s.full_width, s.full_height), (0, 0, 256, 192), path)
+            finally:
+                inp.close()
+        assert_same_pixels(self, got_read, want, "cropped input via ?filter=")
+        assert_same_pixels(self, got_out, want, "cropped input via -o:fileformatname=mcrecon")
+
     def test_parameters_and_pass_overrides_in_all_three_styles(self):
         want = self.path("cli.exr")
         tu.run_cli("denoise", ROOM, "-o", want, "-f", "box", "--set", "radius=3", "--set", "demodulate=true",

@@ -374,6 +374,89 @@ TEST_F(FrameIoTest, WriteResultThenReadFrameRoundTrips) {
   EXPECT_EQ(spec_in->spec().get_string_attribute("mcreconFilter"), "box");
 }
 
+// One OpenEXR file with a part per spec; part k's channel c of pixel (x,y) holds
+// value_of(x, y, 10 k + c) (distinct across parts).
+void write_parts(const std::string& path, const std::vector<OIIO::ImageSpec>& specs) {
+  auto out = OIIO::ImageOutput::create(path);
+  ASSERT_TRUE(out) << OIIO::geterror();
+  ASSERT_TRUE(out->open(path, int(specs.size()), specs.data())) << out->geterror();
+  for (std::size_t k = 0; k < specs.size(); ++k) {
+    const OIIO::ImageSpec& s = specs[k];
+    if (k > 0) ASSERT_TRUE(out->open(path, s, OIIO::ImageOutput::AppendSubimage)) << out->geterror();
+    std::vector<float> px(std::size_t(s.width) * s.height * s.nchannels);
+    for (int y = 0; y < s.height; ++y)
+      for (int x = 0; x < s.width; ++x)
+        for (int c = 0; c < s.nchannels; ++c)
+          px[(std::size_t(y) * s.width + x) * s.nchannels + c] = value_of(x, y, int(k) * 10 + c);
+    ASSERT_TRUE(out->write_image(OIIO::TypeFloat, px.data())) << out->geterror();
+  }
+  out->close();
+}
+
+OIIO::ImageSpec part_spec(const std::string& name, int w, int h, const Names& channels) {
+  OIIO::ImageSpec s(w, h, int(channels.size()), OIIO::TypeFloat);
+  s.channelnames = channels;
+  s.alpha_channel = -1;
+  s.attribute("name", name);
+  return s;
+}
+
+TEST_F(FrameIoTest, MultiPartFileJoinsEveryPartPrefixingRepeatedNames) {
+  // Beauty, a normal part reusing R,G,B (the usual multi-part layout) and a depth part.
+  write_parts(path("parts.exr"), {part_spec("rgba", 4, 3, {"R", "G", "B", "A"}), part_spec("normal", 4, 3, {"R", "G", "B"}),
+                                  part_spec("depth", 4, 3, {"Z"})});
+  const Frame f = read_frame(path("parts.exr"));
+  const Pass& n = f.get(Role::Normal);
+  EXPECT_EQ(n.channels, (Names{"normal.R", "normal.G", "normal.B"}));
+  const Pass& z = f.get(Role::Depth);
+  for (int y = 0; y < 3; ++y)
+    for (int x = 0; x < 4; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_EQ(f.image(Role::Colour).at(x, y, c), value_of(x, y, c));
+        EXPECT_EQ(n.image.at(x, y, c), value_of(x, y, 10 + c));
+      }
+      EXPECT_EQ(z.image.at(x, y, 0), value_of(x, y, 20));
+    }
+}
+
+TEST_F(FrameIoTest, MultiPartFileWithDifferentDataWindowsIsASizeMismatchNamingThePart) {
+  OIIO::ImageSpec shifted = part_spec("normal", 4, 3, {"R", "G", "B"});
+  shifted.x = 2;
+  write_parts(path("parts.exr"), {part_spec("rgba", 4, 3, {"R", "G", "B", "A"}), shifted});
+  try {
+    read_frame(path("parts.exr"));
+    FAIL() << "expected a SizeMismatch";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), Errc::SizeMismatch);
+    EXPECT_NE(std::string(e.what()).find("part 1 'normal'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("parts.exr"), std::string::npos) << e.what();
+  }
+}
+
+TEST_F(FrameIoTest, DataWindowAndDisplayWindowSurviveARoundTrip) {
+  // A 5x4 crop at (7, 3) of a 32x24 frame (Blender's "crop to render region", overscan).
+  OIIO::ImageSpec spec = part_spec("", 5, 4, {"R", "G", "B", "A"});
+  spec.x = 7;
+  spec.y = 3;
+  spec.full_x = 0;
+  spec.full_y = 0;
+  spec.full_width = 32;
+  spec.full_height = 24;
+  write_parts(path("crop.exr"), {spec});
+  const Frame in = read_frame(path("crop.exr"));
+  EXPECT_EQ(in.width, 5);
+  EXPECT_EQ(in.window.x, 7);
+  EXPECT_EQ(in.window.y, 3);
+  EXPECT_EQ(in.image(Role::Colour).at(0, 0, 0), value_of(0, 0, 0));  // pixels start at the data window
+  write_result(path("out.exr"), in.image(Role::Colour), in);
+  auto back = OIIO::ImageInput::open(path("out.exr"));
+  ASSERT_TRUE(back);
+  const OIIO::ImageSpec& s = back->spec();
+  EXPECT_EQ((std::vector<int>{s.x, s.y, s.width, s.height}), (std::vector<int>{7, 3, 5, 4}));
+  EXPECT_EQ((std::vector<int>{s.full_x, s.full_y, s.full_width, s.full_height}), (std::vector<int>{0, 0, 32, 24}));
+  EXPECT_EQ(read_frame(path("out.exr")).image(Role::Colour).storage(), in.image(Role::Colour).storage());
+}
+
 TEST_F(FrameIoTest, WriteResultWithoutAlphaWritesOne) {
   write_exr(path("rgb.exr"), 3, 3, {"R", "G", "B"});
   const Frame in = read_frame(path("rgb.exr"));
