@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Render mcrecon's sample scenes with Blender (Cycles, CPU) and write samples/data/manifest.json.
 
-    python3 samples/render_samples.py                       # everything (~12 min on 2 idle cores)
+    python3 samples/render_samples.py                       # everything (~25 min on 2 idle cores)
     python3 samples/render_samples.py --scenes room,dof     # some scenes (manifest entries merged)
     python3 samples/render_samples.py --spp 1,4 --ref-spp 256 --out /tmp/quick   # quick look
 
@@ -48,11 +48,11 @@ def parse_args():
     p.add_argument("--out", default=os.path.join(HERE, "data"), help="data folder")
     p.add_argument("--spp", type=int_list, default=[1, 4, 16, 64], help="noisy spp of the stills")
     p.add_argument("--ref-spp", type=int, default=2048, help="reference spp of the stills")
-    p.add_argument("--anim-spp", type=int_list, default=[1, 4], help="noisy spp of the animation")
-    p.add_argument("--anim-ref-spp", type=int, default=512, help="reference spp per frame")
+    p.add_argument("--anim-spp", type=int_list, default=[1], help="noisy spp of the animation")
+    p.add_argument("--anim-ref-spp", type=int, default=128, help="reference spp per frame")
     p.add_argument("--frames", default="1-16", help="animation frame range")
     p.add_argument("--still-size", default="256x192", help="WxH of the stills")
-    p.add_argument("--anim-size", default="160x90", help="WxH of the animation")
+    p.add_argument("--anim-size", default="320x180", help="WxH of the animation")
     p.add_argument("--threads", type=int, default=0, help="Cycles threads (0 = all cores)")
     p.add_argument("--blender", default=os.environ.get("BLENDER", "blender"))
     return p.parse_args()

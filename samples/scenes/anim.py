@@ -112,6 +112,6 @@ def build():
 
 
 if __name__ == "__main__":
-    args = C.parse_args("anim", default_size=(160, 90), sequence=True)
+    args = C.parse_args("anim", default_size=(320, 180), sequence=True)
     build()
     C.render_jobs(args, "anim")
