@@ -2,9 +2,10 @@
 // on the sample animation.
 //
 //   mcrecon_bench_bmfr [--threads N] [--repeat N] [--frames N] [--quality-only] [--speed-only]
+//                      [--default-only]   (speed: the default configuration only)
 //                      [--try "key=value ..."]... [--only-tries]   (extra bmfr configurations)
 //
-// Speed: the `anim` frames (1 spp) upscaled bilinearly x8 to 1280x720 (motion vectors x8),
+// Speed: the `anim` frames (1 spp) upscaled bilinearly to 1280x720 (x4; motion vectors scaled too),
 // run as a sequence; per-stage and total milliseconds per frame, best of `repeat` passes
 // over the sequence (each pass after a reset, first frame of each pass excluded: it has no
 // history), wall and process CPU time (all threads; the stage CPU times come from
@@ -126,6 +127,7 @@ std::vector<Image> run_filter(Filter& f, const std::vector<Frame>& frames, int t
 
 std::vector<std::string> g_tries;  // --try "k=v k=v": extra bmfr configurations
 bool g_only_tries = false;
+bool g_default_only = false;  // --default-only: the speed table's first configuration only
 
 void quality(int threads) {
   const std::vector<SampleScene> scenes = load_sample_manifest(default_samples_dir());
@@ -136,7 +138,7 @@ void quality(int threads) {
     std::printf("quality: no 'anim' scene in the samples\n");
     return;
   }
-  for (int spp : {1, 4}) {
+  for (const auto& [spp, pattern] : anim->noisy) {
     const LoadedScene scene = load_scene(*anim, spp);
     std::printf("\nquality: anim %d spp, %dx%d, frames %d-%d judged (mean relMSE, mean SSIM, temporal error, ms/frame on %d threads)\n",
                 spp, scene.frames.front().width, scene.frames.front().height, int(scene.frames.size()) / 2 + 1,
@@ -257,9 +259,12 @@ void speed(int threads, int repeat, int nframes) {
   if (!anim) return;
   const LoadedScene scene = load_scene(*anim, 1);
   std::vector<Frame> frames;
-  for (int i = 0; i < nframes && i < int(scene.frames.size()); ++i) frames.push_back(upscale_frame(scene.frames[std::size_t(i)], 8));
-  std::printf("\nspeed: %dx%d (anim 1 spp upscaled x8), %zu frames, %d threads, best of %d passes; load before: %s\n",
-              frames[0].width, frames[0].height, frames.size(), threads, repeat, loadavg().c_str());
+  // Integer factor to 1280 pixels wide (x4 for the 320x180 sample), so 720p for 16:9.
+  const int factor = std::max(1, 1280 / scene.frames.front().width);
+  for (int i = 0; i < nframes && i < int(scene.frames.size()); ++i)
+    frames.push_back(upscale_frame(scene.frames[std::size_t(i)], factor));
+  std::printf("\nspeed: %dx%d (anim 1 spp upscaled x%d), %zu frames, %d threads, best of %d passes; load before: %s\n",
+              frames[0].width, frames[0].height, factor, frames.size(), threads, repeat, loadavg().c_str());
   std::printf("  wall ms per frame (best pass), then process CPU ms (all threads) per stage and per frame\n");
   std::printf("  %-28s %7s %7s %7s %7s %7s | %6s %6s %6s %6s %9s\n", "config", "phaseI", "fit", "phIII", "taa", "total", "cI",
               "cfit", "cIII", "ctaa", "cpu/frame");
@@ -275,6 +280,7 @@ void speed(int threads, int repeat, int nframes) {
   ExecOptions eo;
   eo.nthreads = threads;
   for (const Config& c : configs) {
+    if (g_default_only && &c != &configs.front()) break;
     auto f = make_filter("bmfr");
     for (const auto& kv : c.params) f->set_text(kv.first, kv.second);
     f->commit();
@@ -340,8 +346,9 @@ int main(int argc, char** argv) {
     else if (a == "--try" && i + 1 < argc) g_tries.push_back(argv[++i]);
     else if (a == "--only-tries") g_only_tries = true;
     else if (a == "--speed-only") do_quality = false;
+    else if (a == "--default-only") g_default_only = true;
     else {
-      std::fprintf(stderr, "usage: mcrecon_bench_bmfr [--threads N] [--repeat N] [--frames N] [--quality-only] [--speed-only]\n");
+      std::fprintf(stderr, "usage: mcrecon_bench_bmfr [--threads N] [--repeat N] [--frames N] [--quality-only] [--speed-only] [--default-only]\n");
       return 2;
     }
   }

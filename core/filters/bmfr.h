@@ -19,9 +19,10 @@ namespace mcr {
 // shorter side has >= 360 pixels (720p and up), 16 below (e.g. the 160x90 samples, where
 // a 32-pixel block spans a third of the image height).
 // Speed: every per-frame buffer is kept between frames; the reprojection and the albedo
-// demodulation run in the same row pass as phase I, and phase III, remodulation and the
-// TAA colour-space conversion in one pass; the fit works on planar float features per
-// block (double only in the QR and the synthesis sums), one task per block.
+// demodulation run in the same row pass as phase I, phase III and the remodulation in one
+// pass (into a planar result), the TAA in one pass that writes the output too; the fit
+// works on planar float features per block (double only in the QR and the synthesis
+// sums), one task per block. The filter runs in place (no output copy in the base class).
 // Temporal: history lives in the object; reset() drops it. A size change or a camera
 // cut (more than cut_fraction of the pixels lose every reprojection tap) restarts it.
 // The whole frame is always processed (history needs it); only the roi is written.
@@ -51,17 +52,23 @@ class BmfrFilter : public Filter {
  protected:
   void check_params() override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
+  // run() reads the colour in phase I only and writes the whole roi at the end.
+  bool run_in_place() const override { return true; }
 
  private:
+  // Phase II (bmfr_fit.cpp).
   void fit_blocks(const Frame& frame, const Image& illum, const std::vector<float>& valid, Image& fitted, int nthreads);
-  void taa(const Reprojection& rep, bool history, int nthreads);
+  // TAA of res_ into the roi of `out` and the next history (bmfr_taa.cpp).
+  void taa(const Reprojection& rep, bool history, const Roi& roi, Image& out, int nthreads);
+  static void write_planar_roi(const float* planar, std::size_t n, int w, const Roi& roi, Image& out, int nthreads);
 
   TemporalAccumulator phase1_;
   AccumulationBuffer phase3_;
-  Image taa_history_;
   // Per-frame work buffers, kept between frames so that a steady sequence allocates nothing.
-  Image illum_, albedo_, fitted_, result_, taa_next_;
-  std::vector<float> space_;  // TAA: the result in the clipping colour space, planar
+  Image illum_, albedo_, fitted_;
+  std::vector<float> res_;                 // phase III result (remodulated), planar RGB
+  std::vector<float> taa_hist_, taa_next_;  // TAA history (the previous output), planar RGB
+  int taa_w_ = 0, taa_h_ = 0;              // size of taa_hist_ (0: none)
   std::int64_t frame_index_ = 0;
   bool last_cut_ = false;
   std::array<double, kStages> stage_ms_{};

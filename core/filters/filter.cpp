@@ -89,7 +89,26 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     note("filled " + std::to_string(std::count(holes.begin(), holes.end(), 0.0f)) + " unsampled pixels by pull-push");
   }
   const Image& input = src->image(Role::Colour);
-  Image colour = input.channels() == 3 ? input : input.channel_range(0, 3);
+  const int nthreads = options.nthreads;
+  const int w = frame.width, h = frame.height;
+  // The RGB working copy of the colour, row-parallel (it becomes the output for filters
+  // that run in place).
+  if (input.channels() < 3) (void)input.channel_range(0, 3);  // throws: no RGB
+  Image colour(input.width(), input.height(), 3);
+  {
+    const int ich = input.channels();
+    const std::size_t iw = std::size_t(input.width());
+    parallel_rows(0, input.height(), nthreads, [&](int y) {
+      const float* s = input.data() + std::size_t(y) * iw * std::size_t(ich);
+      float* d = colour.data() + std::size_t(y) * iw * 3;
+      if (ich == 3) {
+        std::copy(s, s + iw * 3, d);
+        return;
+      }
+      for (std::size_t x = 0; x < iw; ++x)
+        for (int c = 0; c < 3; ++c) d[x * 3 + std::size_t(c)] = s[x * std::size_t(ich) + std::size_t(c)];
+    });
+  }
 
   // Albedo demodulation: filter the illumination, not the texture.
   Image albedo;
@@ -98,25 +117,58 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     if (!a) throw Error(Errc::MissingPass, "filter '" + info_.name + "': demodulate=true needs the albedo pass, absent in '" + frame.path + "'");
     const float lo = float(params_.get_float("albedo_floor"));
     albedo = Image(frame.width, frame.height, 3);
-    for (std::size_t i = 0; i < albedo.pixel_count(); ++i)
-      for (int c = 0; c < 3; ++c) {
-        const float v = a->image.data()[i * std::size_t(a->image.channels()) + std::size_t(std::min(c, a->image.channels() - 1))];
-        albedo.data()[i * 3 + c] = std::isfinite(v) ? std::clamp(v, lo, 1.0f) : 1.0f;
-      }
-    for (std::size_t i = 0; i < colour.storage().size(); ++i) colour.storage()[i] /= albedo.storage()[i];
+    const int ach = a->image.channels();
+    parallel_rows(0, h, nthreads, [&](int y) {
+      const std::size_t b = std::size_t(y) * std::size_t(w), e = b + std::size_t(w);
+      for (std::size_t i = b; i < e; ++i)
+        for (int c = 0; c < 3; ++c) {
+          const float v = a->image.data()[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];
+          const float al = std::isfinite(v) ? std::clamp(v, lo, 1.0f) : 1.0f;
+          albedo.data()[i * 3 + std::size_t(c)] = al;
+          colour.data()[i * 3 + std::size_t(c)] /= al;
+        }
+    });
   }
 
-  Image out = colour;
   Roi roi = options.roi.empty() ? Roi::all(frame.width, frame.height) : options.roi.clipped(frame.width, frame.height);
-  if (roi.empty()) return out;
-  run(*src, colour, roi, out, options.nthreads);
-  if (!albedo.empty())
-    for (std::size_t i = 0; i < out.storage().size(); ++i) out.storage()[i] *= albedo.storage()[i];
+  if (roi.empty()) return colour;
+  Image out;
+  if (run_in_place()) {
+    run(*src, colour, roi, colour, nthreads);
+    out = std::move(colour);
+  } else {
+    out = colour;
+    run(*src, colour, roi, out, nthreads);
+  }
 
-  // Safety net: nothing non-finite ever leaves a filter.
+  // Remodulation and the safety net (nothing non-finite ever leaves a filter), one
+  // row-parallel pass; the per-row counts are added in row order.
+  std::vector<std::size_t> row_repaired(std::size_t(std::max(h, 0)), 0);
+  const std::size_t rw = std::size_t(w) * 3;
+  if (out.storage().size() == rw * std::size_t(h))
+    parallel_rows(0, h, nthreads, [&](int y) {
+      float* o = out.data() + std::size_t(y) * rw;
+      if (!albedo.empty()) {
+        const float* al = albedo.data() + std::size_t(y) * rw;
+        for (std::size_t i = 0; i < rw; ++i) o[i] *= al[i];
+      }
+      // Branch-free scan first: almost every row is finite.
+      bool all = true;
+      for (std::size_t i = 0; i < rw; ++i) all &= std::fabs(o[i]) <= 3.402823466e38f;
+      if (all) return;
+      std::size_t n = 0;
+      for (std::size_t i = 0; i < rw; ++i)
+        if (!std::isfinite(o[i])) { o[i] = 0.0f; ++n; }
+      row_repaired[std::size_t(y)] = n;
+    });
+  else {  // a filter that resized its output (none does): the plain loops
+    if (!albedo.empty())
+      for (std::size_t i = 0; i < out.storage().size() && i < albedo.storage().size(); ++i) out.storage()[i] *= albedo.storage()[i];
+    for (float& v : out.storage())
+      if (!std::isfinite(v)) { v = 0.0f; ++row_repaired[0]; }
+  }
   repaired_ = 0;
-  for (float& v : out.storage())
-    if (!std::isfinite(v)) { v = 0.0f; ++repaired_; }
+  for (std::size_t v : row_repaired) repaired_ += v;
   if (repaired_) note(std::to_string(repaired_) + " non-finite output values replaced by 0");
   return out;
 }

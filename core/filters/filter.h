@@ -74,6 +74,10 @@ class Filter {
   // not frame's colour pass. frame: every pass (holes filled too). out arrives as a
   // copy of colour; write the result inside roi.
   virtual void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) = 0;
+  // True when run() reads `colour` only before it writes any pixel of `out` and writes
+  // every pixel of the roi: the base class then passes the colour buffer itself as `out`
+  // (the same object: no copy of the frame; pixels outside the roi keep the input).
+  virtual bool run_in_place() const { return false; }
   void note(std::string text) { notes_.push_back(std::move(text)); }
 
   ParamSet params_;

@@ -24,8 +24,86 @@ void AccumulationBuffer::begin(const Reprojection& r, const Image& current) {
   next_count_.resize(current.pixel_count());  // every entry is rewritten by row()
 }
 
+namespace {
+
+// Row y of the blend for 3 channels (every BMFR buffer): the generic loop below with the
+// channel count fixed, so the history and the blend stay in registers. Same operations in
+// the same order.
+void row3(int y, const Reprojection& r, const float* crow_all, const float* hist, const float* hcount, float af,
+          int w, float* orow, float* ncount) {
+  const float* crow = crow_all + std::size_t(y) * std::size_t(w) * 3;
+  const std::uint8_t* taps = r.taps.data() + std::size_t(y) * std::size_t(w);
+  const float* pxs = r.prev_x.data() + std::size_t(y) * std::size_t(w);
+  const float* pys = r.prev_y.data() + std::size_t(y) * std::size_t(w);
+  const std::size_t sw = std::size_t(w);
+  for (int x = 0; x < w; ++x) {
+    const float* c = crow + std::size_t(x) * 3;
+    float* o = orow + std::size_t(x) * 3;
+    const float c0 = c[0], c1 = c[1], c2 = c[2];
+    const bool finite = ((c0 - c0) + (c1 - c1) + (c2 - c2)) == 0.0f;  // x - x is NaN for NaN/Inf
+    float h0 = 0, h1 = 0, h2 = 0, n = 0;
+    bool have = false;
+    const std::uint8_t mask = hist ? taps[x] : 0;
+    if (mask) {
+      const float px = pxs[x], py = pys[x];
+      const int x0 = floor_int(px), y0 = floor_int(py);
+      const float fx = px - float(x0), fy = py - float(y0);
+      const float wt[4] = {(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy};
+      const std::size_t t0 = std::size_t(y0) * sw + std::size_t(x0);
+      const std::size_t tt[4] = {t0, t0 + 1, t0 + sw, t0 + sw + 1};
+      float sum = 0, cnt = 0;
+      for (int k = 0; k < 4; ++k) {
+        if (!(mask & (1u << k)) || wt[k] <= 0.0f) continue;
+        const std::size_t t = tt[k];
+        const float tc = hcount[t];
+        if (!(tc > 0.0f)) continue;
+        sum += wt[k];
+        cnt += wt[k] * tc;
+        const float* hp = hist + t * 3;
+        h0 += wt[k] * hp[0];
+        h1 += wt[k] * hp[1];
+        h2 += wt[k] * hp[2];
+      }
+      if (sum > 1e-6f) {
+        const float inv = 1.0f / sum;
+        h0 *= inv;
+        h1 *= inv;
+        h2 *= inv;
+        n = std::max(1.0f, float(int(cnt * inv + 0.5f)));
+        have = true;
+      }
+    }
+    if (!finite) {
+      o[0] = have ? h0 : 0.0f;  // invalid without history: value 0, count 0
+      o[1] = have ? h1 : 0.0f;
+      o[2] = have ? h2 : 0.0f;
+      ncount[x] = have ? n : 0.0f;
+      continue;
+    }
+    if (!have) {
+      o[0] = c0;
+      o[1] = c1;
+      o[2] = c2;
+      ncount[x] = 1.0f;
+      continue;
+    }
+    const float wn = std::max(1.0f / (n + 1.0f), af);
+    o[0] = h0 + wn * (c0 - h0);
+    o[1] = h1 + wn * (c1 - h1);
+    o[2] = h2 + wn * (c2 - h2);
+    ncount[x] = std::min(n + 1.0f, 65535.0f);
+  }
+}
+
+}  // namespace
+
 void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current, double alpha) {
   const int w = current.width(), h = current.height(), ch = current.channels();
+  if (ch == 3) {
+    row3(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha), w,
+         next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
+    return;
+  }
   const float* hist = usable_ ? value_.data() : nullptr;
   const float* hcount = usable_ ? count_.data() : nullptr;
   const float af = float(alpha);

@@ -3,21 +3,13 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <limits>
 
 #include "util/parallel.h"
 
 namespace mcr {
 
 namespace {
-
-bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
-
-double dist2(const float* a, const float* b) {
-  const double dx = double(a[0]) - b[0], dy = double(a[1]) - b[1], dz = double(a[2]) - b[2];
-  return dx * dx + dy * dy + dz * dz;
-}
-
-double norm2(const float* a) { return double(a[0]) * a[0] + double(a[1]) * a[1] + double(a[2]) * a[2]; }
 
 }  // namespace
 
@@ -26,6 +18,8 @@ void GeometryHistory::reset() {
   normal_ = Image();
   next_position_ = Image();
   next_normal_ = Image();
+  info_.clear();
+  next_info_.clear();
 }
 
 namespace {
@@ -45,12 +39,13 @@ void GeometryHistory::begin(const Image& position, const Image& normal, const Im
   r.prev_y.resize(n);
   r.taps.resize(n);
   r.inside.resize(n);
-  r.has_history = !position_.empty() && position_.width() == w && position_.height() == h;
+  r.has_history = !position_.empty() && position_.width() == w && position_.height() == h && info_.size() == n;
   r.cut = false;
   r.discarded = 0;
   if (motion && (motion->width() != w || motion->height() != h || motion->channels() < 2)) motion = nullptr;
   ensure(next_position_, w, h, 3);
   ensure(next_normal_, w, h, 3);
+  next_info_.resize(n);
 }
 
 std::size_t GeometryHistory::row(int y, const Image& position, const Image& normal, const Image* motion,
@@ -63,12 +58,33 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
   {
     float* dp = next_position_.data() + std::size_t(y) * w * 3;
     float* dn = next_normal_.data() + std::size_t(y) * w * 3;
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) {
-        dp[x * 3 + c] = prow[std::size_t(x) * pc_ch + c];
-        dn[x * 3 + c] = nrow[std::size_t(x) * nc_ch + c];
-      }
+    if (pc_ch == 3)
+      std::copy(prow, prow + std::size_t(w) * 3, dp);
+    else
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) dp[x * 3 + c] = prow[std::size_t(x) * pc_ch + c];
+    if (nc_ch == 3)
+      std::copy(nrow, nrow + std::size_t(w) * 3, dn);
+    else
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < 3; ++c) dn[x * 3 + c] = nrow[std::size_t(x) * nc_ch + c];
   }
+  // Per pixel of the stored row: the squared normal length when position and normal are
+  // finite, NaN otherwise (read by the tap tests of the next frame, and below).
+  {
+    const float* dp = next_position_.data() + std::size_t(y) * w * 3;
+    const float* dn = next_normal_.data() + std::size_t(y) * w * 3;
+    float* inf = next_info_.data() + std::size_t(y) * w;
+    for (int x = 0; x < w; ++x) {
+      const float* p = dp + std::size_t(x) * 3;
+      const float* q = dn + std::size_t(x) * 3;
+      const float fin = (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]) + (q[0] - q[0]) + (q[1] - q[1]) + (q[2] - q[2]);
+      const float l = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
+      inf[x] = fin == 0.0f ? l : std::numeric_limits<float>::quiet_NaN();
+    }
+  }
+  const float* cinfo = next_info_.data() + std::size_t(y) * w;
+  const float* hinfo = info_.data();
   const float* mrow = motion ? motion->data() + std::size_t(y) * w * motion->channels() : nullptr;
   const int mch = motion ? motion->channels() : 0;
   const float* hp = position_.data();
@@ -114,12 +130,12 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
     r.inside[i] = in;
     const float* pc = prow + std::size_t(x) * pc_ch;
     const float* nc = nrow + std::size_t(x) * nc_ch;
-    if (!in || !fin3(pc) || !fin3(nc)) {
+    const float ncl = cinfo[x];  // squared normal length; NaN: non-finite position or normal
+    if (!in || ncl != ncl) {
       r.taps[i] = 0;
       ++lost;
       continue;
     }
-    const float ncl = nc[0] * nc[0] + nc[1] * nc[1] + nc[2] * nc[2];  // squared length
     // Squared distance limit.
     float limit = thr2;
     if (relative) {
@@ -142,12 +158,12 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
     std::uint8_t mask = 0;
     for (int k = 0; k < 4; ++k) {
       if (!(in & (1u << k))) continue;
-      const std::size_t t = (std::size_t(y0 + (k >> 1)) * w + std::size_t(x0 + (k & 1))) * 3;
+      const std::size_t ti = std::size_t(y0 + (k >> 1)) * w + std::size_t(x0 + (k & 1)), t = ti * 3;
+      const float npl = hinfo[ti];
+      if (npl != npl) continue;  // non-finite history position or normal
       const float* pp = hp + t;
       const float* np = hn + t;
-      if (!fin3(pp) || !fin3(np)) continue;
       if (!(d2(pc, pp) <= limit)) continue;
-      const float npl = np[0] * np[0] + np[1] * np[1] + np[2] * np[2];
       if (ncl < 1e-6f && npl < 1e-6f) {
         // both background / no normal: agree
       } else {
@@ -176,6 +192,7 @@ bool GeometryHistory::finish(const ReprojectionParams& params, Reprojection& r, 
   }
   std::swap(position_, next_position_);
   std::swap(normal_, next_normal_);
+  std::swap(info_, next_info_);
   return r.cut;
 }
 

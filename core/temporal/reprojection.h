@@ -82,6 +82,8 @@ class GeometryHistory {
  private:
   Image position_, normal_;   // previous frame (3 channels)
   Image next_position_, next_normal_;  // current frame, filled by row()
+  // Per pixel: squared normal length when position and normal are finite, else NaN.
+  std::vector<float> info_, next_info_;
 };
 
 // floor() as an int for |v| < 2^31 (reprojected positions are kept within +-1e7): inline

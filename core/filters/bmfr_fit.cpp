@@ -1,0 +1,331 @@
+// BMFR phase II: per-block least-squares fit of the accumulated illumination to the
+// multi-order features (Koskela et al. 2019, 4.2), one task per block.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "filters/bmfr.h"
+#include "linalg/householder_qr.h"
+#include "util/parallel.h"
+
+#include <tbb/enumerable_thread_specific.h>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#endif
+
+namespace mcr {
+
+namespace {
+
+constexpr double kFloatMax = std::numeric_limits<float>::max();
+
+
+// Counter-based random numbers (splitmix64): the noise of a block depends on
+// (seed, frame, block) only, never on the thread that fits it.
+std::uint64_t splitmix(std::uint64_t& s) {
+  std::uint64_t z = (s += 0x9E3779B97F4A7C15ull);
+  z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+  z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+  return z ^ (z >> 31);
+}
+
+// Raw (unscaled) feature channels per feature set. The fitted columns are then
+// [1, raw scaled to [-1,1] ..., squares of the scaled positions rescaled to [-1,1]].
+struct FeatureLayout {
+  bool squares = true;        // w^2 columns
+  bool albedo = false;        // + albedo RGB
+  bool depth = false;         // + depth
+  int raw() const { return 6 + (albedo ? 3 : 0) + (depth ? 1 : 0); }
+  int columns() const { return 1 + raw() + (squares ? 3 : 0); }
+};
+
+FeatureLayout layout_of(const std::string& set) {
+  FeatureLayout l;
+  if (set == "first_order") l.squares = false;
+  if (set == "with_albedo") l.albedo = true;
+  if (set == "with_depth") l.depth = true;
+  return l;
+}
+
+
+// Per-thread scratch of the fit, sized once for the largest block.
+// Min and max of src over the pixels with mask 1 (+inf / -inf when none). Exact: the
+// order of a min/max does not matter.
+void masked_min_max(const float* src, const float* mask, int np, float& lo, float& hi) {
+  int i = 0;
+  float l = INFINITY, u = -INFINITY;
+#if defined(__SSE2__)
+  const __m128 inf = _mm_set1_ps(INFINITY), ninf = _mm_set1_ps(-INFINITY), zero = _mm_setzero_ps();
+  __m128 l4 = inf, u4 = ninf, l4b = inf, u4b = ninf;
+  for (; i + 8 <= np; i += 8) {
+    const __m128 m = _mm_cmpneq_ps(_mm_loadu_ps(mask + i), zero), mb = _mm_cmpneq_ps(_mm_loadu_ps(mask + i + 4), zero);
+    const __m128 v = _mm_loadu_ps(src + i), vb = _mm_loadu_ps(src + i + 4);
+    l4 = _mm_min_ps(l4, _mm_or_ps(_mm_and_ps(m, v), _mm_andnot_ps(m, inf)));
+    u4 = _mm_max_ps(u4, _mm_or_ps(_mm_and_ps(m, v), _mm_andnot_ps(m, ninf)));
+    l4b = _mm_min_ps(l4b, _mm_or_ps(_mm_and_ps(mb, vb), _mm_andnot_ps(mb, inf)));
+    u4b = _mm_max_ps(u4b, _mm_or_ps(_mm_and_ps(mb, vb), _mm_andnot_ps(mb, ninf)));
+  }
+  float lt[4], ut[4];
+  _mm_storeu_ps(lt, _mm_min_ps(l4, l4b));
+  _mm_storeu_ps(ut, _mm_max_ps(u4, u4b));
+  for (int k = 0; k < 4; ++k) {
+    l = std::min(l, lt[k]);
+    u = std::max(u, ut[k]);
+  }
+#endif
+  for (; i < np; ++i)
+    if (mask[i] != 0.0f) {
+      l = std::min(l, src[i]);
+      u = std::max(u, src[i]);
+    }
+  lo = l;
+  hi = u;
+}
+
+// dst = mask ? clamp((src - lo) * sc - 1, -1, 1) : 0 (src finite where mask is 1).
+void scale_masked(const float* src, const float* mask, int np, float lo, float sc, float* dst) {
+  int i = 0;
+#if defined(__SSE2__)
+  const __m128 lo4 = _mm_set1_ps(lo), sc4 = _mm_set1_ps(sc), one = _mm_set1_ps(1.0f), mone = _mm_set1_ps(-1.0f),
+               zero = _mm_setzero_ps();
+  for (; i + 4 <= np; i += 4) {
+    const __m128 m = _mm_cmpneq_ps(_mm_loadu_ps(mask + i), zero);
+    const __m128 v = _mm_sub_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(src + i), lo4), sc4), one);
+    _mm_storeu_ps(dst + i, _mm_and_ps(m, _mm_min_ps(_mm_max_ps(v, mone), one)));
+  }
+#endif
+  for (; i < np; ++i) {
+    const float v = std::clamp((src[i] - lo) * sc - 1.0f, -1.0f, 1.0f);
+    dst[i] = mask[i] != 0.0f ? v : 0.0f;
+  }
+}
+
+struct FitScratch {
+  std::vector<float> raw;    // R columns x np, planar
+  std::vector<float> feat;   // M columns x np, planar, scaled, noise-free
+  std::vector<float> fin;    // 1: finite features
+  std::vector<float> z;      // 3 x np, planar illumination
+  std::vector<int> rows;
+  std::vector<double> mat;   // W x (M + 3), column-major
+  std::vector<double> acc;   // 3 x np synthesis
+  AugmentedQr qr;
+};
+
+}  // namespace
+
+void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::vector<float>& valid, Image& fitted,
+                            int nthreads) {
+  const int w = frame.width, h = frame.height;
+  const int B = block_side(params_.get_int("block_size"), w, h);
+  const FeatureLayout lay = layout_of(params_.get_enum("features"));
+  const double eps = params_.get_float("epsilon");
+  const std::uint64_t seed = std::uint64_t(params_.get_int("seed"));
+  const bool clamp_max = params_.get_bool("fit_clamp");
+  const Image& pos = frame.image(Role::Position, Prefer::Geometry);
+  const Image& nrm = frame.image(Role::Normal, Prefer::Geometry);
+  const Image* alb = lay.albedo ? &frame.image(Role::Albedo) : nullptr;
+  const Image* dep = lay.depth ? &frame.image(Role::Depth) : nullptr;
+
+  int ox = 0, oy = 0;
+  if (params_.get_bool("offsets")) {
+    const auto& o = grid_offsets()[std::size_t(frame_index_ % 16)];
+    ox = std::min(B - 1, int(o[0] * float(B)));
+    oy = std::min(B - 1, int(o[1] * float(B)));
+  }
+  // Blocks start at -ox + k B: the first and last ones are partial.
+  const int nbx = (w + ox + B - 1) / B, nby = (h + oy + B - 1) / B;
+  const int R = lay.raw(), M = lay.columns();
+  const std::size_t cap = std::size_t(B) * std::size_t(B);
+  const int pch = pos.channels(), nch = nrm.channels();
+
+  // One task per block (rows of blocks would leave a thread idle on the last ones); the
+  // result of a block depends on (seed, frame, block) only.
+  const int nblocks = nbx * nby;
+  tbb::task_arena arena(arena_threads(nthreads));
+  tbb::enumerable_thread_specific<FitScratch> scratch;
+  arena.execute([&] {
+    tbb::parallel_for(tbb::blocked_range<int>(0, nblocks, 1), [&](const tbb::blocked_range<int>& range) {
+      FitScratch& S = scratch.local();
+      if (S.fin.size() < cap) {
+        S.raw.resize(cap * std::size_t(R));
+        S.feat.resize(cap * std::size_t(M));
+        S.fin.resize(cap);
+        S.z.resize(cap * 3);
+        S.rows.resize(cap);
+        S.mat.resize(cap * std::size_t(M + 3));
+        S.acc.resize(cap * 3);
+      }
+      for (int b = range.begin(); b != range.end(); ++b) {
+        const int by = b / nbx, bx = b % nbx;
+        const int x0 = std::max(0, bx * B - ox), x1 = std::min(w, (bx + 1) * B - ox);
+        const int y0 = std::max(0, by * B - oy), y1 = std::min(h, (by + 1) * B - oy);
+        if (x1 <= x0 || y1 <= y0) continue;
+        const int bw = x1 - x0, np = bw * (y1 - y0);
+        const std::size_t snp = std::size_t(np);
+        float* raw = S.raw.data();
+        float* feat = S.feat.data();
+        float* fin = S.fin.data();  // 1: every feature finite, 0: not
+        float* zp = S.z.data();     // accumulated illumination, 3 planar columns
+        int* rows = S.rows.data();
+        // Raw features and the illumination, planar, in one sweep over the block's rows; a
+        // pixel with any non-finite feature is left out of the fit and its features read as
+        // mid-range (0 after scaling). Fitted rows: finite features and a valid colour.
+        int p = 0, W = 0;
+        for (int y = y0; y < y1; ++y) {
+          const std::size_t rb = std::size_t(y) * std::size_t(w) + std::size_t(x0);
+          const float* nrow = nrm.data() + rb * std::size_t(nch);
+          const float* prow = pos.data() + rb * std::size_t(pch);
+          const float* irow = illum.data() + rb * 3;
+          const float* vrow = valid.data() + rb;
+          for (int x = 0; x < bw; ++x, ++p) {
+            const float* n = nrow + std::size_t(x) * std::size_t(nch);
+            const float* q = prow + std::size_t(x) * std::size_t(pch);
+            const float v[6] = {n[0], n[1], n[2], q[0], q[1], q[2]};
+            float f = 0.0f;  // x - x: 0 for finite x, NaN otherwise
+            for (int c = 0; c < 6; ++c) {
+              raw[std::size_t(c) * snp + std::size_t(p)] = v[c];
+              f += v[c] - v[c];
+            }
+            int k = 6;
+            if (alb) {
+              const float* a = alb->pixel(x0 + x, y);
+              for (int c = 0; c < 3; ++c, ++k) {
+                const float t = a[std::min(c, alb->channels() - 1)];
+                raw[std::size_t(k) * snp + std::size_t(p)] = t;
+                f += t - t;
+              }
+            }
+            if (dep) {
+              const float t = dep->pixel(x0 + x, y)[0];
+              raw[std::size_t(k) * snp + std::size_t(p)] = t;
+              f += t - t;
+            }
+            const bool ok = f == 0.0f;
+            fin[p] = ok ? 1.0f : 0.0f;
+            for (int c = 0; c < 3; ++c) zp[std::size_t(c) * snp + std::size_t(p)] = irow[std::size_t(x) * 3 + std::size_t(c)];
+            rows[W] = p;
+            W += (ok && vrow[x] > 0.0f) ? 1 : 0;
+          }
+        }
+        // Scaled to [-1, 1] over the block's finite pixels; a column constant within float
+        // rounding is 0 (the constant column carries it).
+        auto scale_column = [&](const float* src, float* dst) {
+          float lo, hi;
+          masked_min_max(src, fin, np, lo, hi);
+          const double range = double(hi) - double(lo);
+          if (!(range > 1e-5 * std::max(std::fabs(double(lo)), std::fabs(double(hi)))) || !(range > 1e-30) ||
+              !std::isfinite(range)) {
+            std::fill(dst, dst + np, 0.0f);
+            return;
+          }
+          scale_masked(src, fin, np, lo, float(2.0 / range), dst);
+        };
+        std::fill(feat, feat + np, 1.0f);
+        // Columns: 0 constant; 1..3 normal; 4..6 position; [7..9 position^2]; extras.
+        for (int c = 0; c < R; ++c) {
+          const int col = c < 6 ? 1 + c : 1 + c + (lay.squares ? 3 : 0);
+          scale_column(raw + std::size_t(c) * snp, feat + std::size_t(col) * snp);
+        }
+        if (lay.squares)
+          for (int c = 0; c < 3; ++c) {
+            // Square of the scaled position: the same span as w^2 with w, better conditioned.
+            float* sq = raw;  // raw column 0 is no longer needed: reuse as scratch
+            const float* s0 = feat + std::size_t(4 + c) * snp;
+            for (int i = 0; i < np; ++i) sq[i] = s0[i] * s0[i];
+            scale_column(sq, feat + std::size_t(7 + c) * snp);
+          }
+        if (W == 0) {
+          for (int y = y0; y < y1; ++y) {
+            float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
+            std::fill(o, o + std::size_t(bw) * 3, std::numeric_limits<float>::quiet_NaN());
+          }
+          continue;
+        }
+        double* mat = S.mat.data();
+        const std::size_t sW = std::size_t(W);
+        std::uint64_t rng = seed * 0x2545F4914F6CDD1Dull ^ (std::uint64_t(frame_index_) << 32) ^
+                            (std::uint64_t(by) * 65537u + std::uint64_t(bx) + 1);
+        // Per-block noise stream: xorshift64 seeded by splitmix of (seed, frame, block),
+        // two 32-bit uniforms in [-1, 1) per step (plenty for a regulariser).
+        std::uint64_t xs = splitmix(rng) | 1u;
+        const bool dense = W == np;  // every pixel fitted: rows[r] == r
+        for (int r = 0; r < W; ++r) mat[r] = 1.0;  // no noise on the constant: a constant block stays exact
+        // The noise goes on the fitted features only, never on the synthesis ones.
+        const double e31 = eps * (1.0 / 2147483648.0);
+        for (int m = 1; m < M; ++m) {
+          double* col = mat + std::size_t(m) * sW;
+          const float* fm = feat + std::size_t(m) * snp;
+          if (dense)
+            for (int r = 0; r < W; ++r) col[r] = double(fm[r]);
+          else
+            for (int r = 0; r < W; ++r) col[r] = double(fm[rows[r]]);
+          if (eps > 0) {
+            int r = 0;
+            for (; r + 2 <= W; r += 2) {
+              xs ^= xs << 13;
+              xs ^= xs >> 7;
+              xs ^= xs << 17;
+              col[r] += e31 * double(std::int32_t(std::uint32_t(xs)));
+              col[r + 1] += e31 * double(std::int32_t(std::uint32_t(xs >> 32)));
+            }
+            if (r < W) {
+              xs ^= xs << 13;
+              xs ^= xs >> 7;
+              xs ^= xs << 17;
+              col[r] += e31 * double(std::int32_t(std::uint32_t(xs >> 32)));
+            }
+          }
+        }
+        double zmin[3], zmax[3];
+        for (int c = 0; c < 3; ++c) {
+          double* col = mat + std::size_t(M + c) * sW;
+          const float* zc = zp + std::size_t(c) * snp;
+          float zm = INFINITY, zx = -INFINITY;
+          for (int r = 0; r < W; ++r) {
+            const float z = zc[rows[r]];
+            col[r] = double(z);
+            zm = std::min(zm, z);
+            zx = std::max(zx, z);
+          }
+          zmin[c] = double(zm);
+          zmax[c] = double(zx);
+        }
+        S.qr.factorize(mat, W, M, 3);
+        double alpha[3][32];
+        for (int c = 0; c < 3; ++c) S.qr.solve(c, alpha[c]);
+        // Synthesis with the noise-free features (planar, vectorised over the pixels).
+        double* acc = S.acc.data();
+        for (int c = 0; c < 3; ++c) {
+          double* ac = acc + std::size_t(c) * snp;
+          const double a0 = alpha[c][0];
+          for (int i = 0; i < np; ++i) ac[i] = a0;
+          for (int m = 1; m < M; ++m) {
+            const double am = alpha[c][m];
+            if (am == 0.0) continue;
+            const float* fm = feat + std::size_t(m) * snp;
+            for (int i = 0; i < np; ++i) ac[i] += am * double(fm[i]);
+          }
+        }
+        const double zlo[3] = {std::min(0.0, zmin[0]), std::min(0.0, zmin[1]), std::min(0.0, zmin[2])};
+        const double zhi[3] = {std::max(0.0, zmax[0]), std::max(0.0, zmax[1]), std::max(0.0, zmax[2])};
+        for (int y = y0, i = 0; y < y1; ++y) {
+          float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
+          for (int x = 0; x < bw; ++x, ++i)
+            for (int c = 0; c < 3; ++c) {
+              // Radiance is not negative: no fit below min(0, the block's smallest input).
+              // Nor above the block's largest input: an ill-conditioned fit extrapolating at
+              // the pixels it was not fitted on (invalid ones, partial edge blocks) cannot
+              // make a highlight brighter than anything it was given.
+              double v = std::max(acc[std::size_t(c) * snp + std::size_t(i)], zlo[c]);
+              if (clamp_max) v = std::min(v, zhi[c]);
+              o[std::size_t(x) * 3 + std::size_t(c)] =
+                  std::isfinite(v) ? float(std::clamp(v, -kFloatMax, kFloatMax)) : std::numeric_limits<float>::quiet_NaN();
+            }
+        }
+      }
+    });
+  });
+}
+
+}  // namespace mcr
