@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "filters/fireflies.h"
 #include "filters/pull_push.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -14,6 +15,11 @@ ParamTable with_common_params(ParamTable own) {
   own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0, "albedo is clamped to [albedo_floor, 1] for demodulation"));
   own.push_back(ParamSpec::Enum("holes", "auto", {"auto", "none", "sample_count", "alpha"},
                                 "unsampled pixels to fill by pull-push first: auto = sample_count 0 when that pass exists"));
+  own.push_back(ParamSpec::Float("firefly_k", 0.0, 0.0, 1e3,
+                                 "firefly suppression before filtering (and before demodulation): a pixel whose luminance "
+                                 "exceeds mu + max(k sd, 0.01 |mu|) of its window's other pixels is scaled down to that "
+                                 "limit (Guo & Pan 2012, 3.3, clamping instead of replacing); 0 = off"));
+  own.push_back(ParamSpec::Int("firefly_radius", 3, 1, 8, "half width of the firefly statistics window"));
   return own;
 }
 
@@ -108,6 +114,14 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
       for (std::size_t x = 0; x < iw; ++x)
         for (int c = 0; c < 3; ++c) d[x * 3 + std::size_t(c)] = s[x * std::size_t(ich) + std::size_t(c)];
     });
+  }
+
+  // Firefly suppression, on the radiance as rendered (before demodulation).
+  if (params_.get_float("firefly_k") > 0) {
+    std::size_t clamped = 0;
+    colour = suppress_fireflies(colour, int(params_.get_int("firefly_radius")), params_.get_float("firefly_k"),
+                                options.nthreads, &clamped);
+    note("firefly suppression clamped " + std::to_string(clamped) + " pixels");
   }
 
   // Albedo demodulation: filter the illumination, not the texture.
