@@ -1,6 +1,7 @@
 // Run time against error on the sample scenes: every registered filter, a sweep
 // of its main parameter (FilterInfo::sweep_param), with and without albedo
-// demodulation, against the noisy input and the same scene at 4x the samples.
+// demodulation, under the defaults, firefly_k=2 and the filter's sweep_variants,
+// against the noisy input and the same scene at 4x the samples.
 //   mcrecon_bench_quality [--spp 16] [--scenes room,glossy] [--filters a,b] [--threads N] [--json FILE]
 #include <cstdio>
 #include <algorithm>
@@ -58,7 +59,7 @@ int main(int argc, char** argv) {
   }
   try {
     nlohmann::json rows = nlohmann::json::array();
-    std::printf("%-8s %-10s %-26s %10s %10s %8s %7s\n", "scene", "filter", "setting", "ms", "relMSE", "PSNR", "SSIM");
+    std::printf("%-8s %-10s %-50s %10s %10s %8s %7s\n", "scene", "filter", "setting", "ms", "relMSE", "PSNR", "SSIM");
     std::map<std::string, std::vector<std::pair<std::string, Best>>> summary;
     std::map<std::string, std::pair<mcr::ImageMetrics, mcr::ImageMetrics>> noisy;
     for (const mcr::SampleScene& scene : mcr::load_sample_manifest(mcr::default_samples_dir())) {
@@ -68,9 +69,9 @@ int main(int argc, char** argv) {
       mcr::Evaluation more = base;
       if (scene.noisy.count(spp * 4)) more = mcr::evaluate(mcr::load_scene(scene, spp * 4), nullptr, threads);
       noisy[scene.name] = {base.metrics, more.metrics};
-      std::printf("%-8s %-10s %-26s %10s %10.5f %8.3f %7.4f\n", scene.name.c_str(), "(noisy)", (std::to_string(spp) + " spp").c_str(), "-",
+      std::printf("%-8s %-10s %-50s %10s %10.5f %8.3f %7.4f\n", scene.name.c_str(), "(noisy)", (std::to_string(spp) + " spp").c_str(), "-",
                   base.metrics.relmse, base.metrics.psnr, base.metrics.ssim);
-      std::printf("%-8s %-10s %-26s %10s %10.5f %8.3f %7.4f\n", scene.name.c_str(), "(noisy)", (std::to_string(spp * 4) + " spp").c_str(), "-",
+      std::printf("%-8s %-10s %-50s %10s %10.5f %8.3f %7.4f\n", scene.name.c_str(), "(noisy)", (std::to_string(spp * 4) + " spp").c_str(), "-",
                   more.metrics.relmse, more.metrics.psnr, more.metrics.ssim);
       for (const std::string& name : mcr::filter_names()) {
         if (!wanted(filters_wanted, name)) continue;
@@ -80,11 +81,23 @@ int main(int argc, char** argv) {
         if (values.empty() || info.sweep_param.empty()) values = {std::nan("")};
         Best best{"", {}};
         best.ev.metrics.relmse = 1e300;
+        // Variants: the defaults, firefly suppression (a common parameter), the filter's own.
+        std::vector<std::string> variants = {"", "firefly_k=2"};
+        for (const std::string& v : info.sweep_variants) variants.push_back(v);
+        for (const std::string& variant : variants)
         for (bool demod : {false, true}) {
           if (demod && !loaded.frames.front().has(mcr::Role::Albedo)) continue;
           for (double v : values) {
             auto filter = mcr::make_filter(name);
             std::string setting = demod ? "demod " : "";
+            {
+              std::stringstream vs(variant);
+              for (std::string kv; vs >> kv;) {
+                const std::size_t eq = kv.find('=');
+                filter->set_text(kv.substr(0, eq), kv.substr(eq + 1));
+                setting += kv + " ";
+              }
+            }
             if (!std::isnan(v)) {
               filter->set(info.sweep_param, v);
               setting += info.sweep_param + "=" + mcr::param_value_text(filter->params().values().at(info.sweep_param));
@@ -97,7 +110,7 @@ int main(int argc, char** argv) {
             // Best of 3 runs for the time; the error is deterministic.
             mcr::Evaluation ev = mcr::evaluate(loaded, filter.get(), threads);
             for (int rep = 0; rep < 2; ++rep) ev.seconds = std::min(ev.seconds, mcr::evaluate(loaded, filter.get(), threads).seconds);
-            std::printf("%-8s %-10s %-26s %10.2f %10.5f %8.3f %7.4f\n", scene.name.c_str(), name.c_str(), setting.c_str(),
+            std::printf("%-8s %-10s %-50s %10.2f %10.5f %8.3f %7.4f\n", scene.name.c_str(), name.c_str(), setting.c_str(),
                         ev.seconds * 1e3, ev.metrics.relmse, ev.metrics.psnr, ev.metrics.ssim);
             std::fflush(stdout);
             rows.push_back({{"scene", scene.name}, {"filter", name}, {"setting", setting}, {"ms", ev.seconds * 1e3},
@@ -109,12 +122,12 @@ int main(int argc, char** argv) {
       }
     }
     std::printf("\nBest setting per filter at %d spp against the noisy %d-spp render (\"worth 4x the samples\" when both hold):\n", spp, spp * 4);
-    std::printf("%-8s %-10s %-26s %10s %10s %7s %12s %10s\n", "scene", "filter", "setting", "ms", "relMSE", "SSIM", "relMSE<=4x", "SSIM>4x");
+    std::printf("%-8s %-10s %-50s %10s %10s %7s %12s %10s\n", "scene", "filter", "setting", "ms", "relMSE", "SSIM", "relMSE<=4x", "SSIM>4x");
     for (const auto& [scene, list] : summary) {
       const auto& [base, more] = noisy[scene];
-      std::printf("%-8s %-10s %-26s %10s %10.5f %7.4f\n", scene.c_str(), "(noisy4x)", "", "-", more.relmse, more.ssim);
+      std::printf("%-8s %-10s %-50s %10s %10.5f %7.4f\n", scene.c_str(), "(noisy4x)", "", "-", more.relmse, more.ssim);
       for (const auto& [name, b] : list)
-        std::printf("%-8s %-10s %-26s %10.2f %10.5f %7.4f %12s %10s\n", scene.c_str(), name.c_str(), b.setting.c_str(),
+        std::printf("%-8s %-10s %-50s %10.2f %10.5f %7.4f %12s %10s\n", scene.c_str(), name.c_str(), b.setting.c_str(),
                     b.ev.seconds * 1e3, b.ev.metrics.relmse, b.ev.metrics.ssim, b.ev.metrics.relmse <= more.relmse ? "yes" : "no",
                     b.ev.metrics.ssim > more.ssim ? "yes" : "no");
     }

@@ -5,6 +5,7 @@
 
 #include "filters/feature_weights.h"
 #include "filters/foveation.h"
+#include "filters/noise_weight.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -22,6 +23,7 @@ ParamTable atrous_params() {
                      "passes; pass i spaces the taps 2^(i-1) pixels apart (effective size k_g 2^(i-1))"),
   };
   for (ParamSpec& s : feature_params(d)) t.push_back(s);
+  t.push_back(colour_weight_param());
   t.push_back(ParamSpec::Float("colour_sigma_decay", 0.5, 0.05, 1.0,
                                "pass i uses colour_sigma * decay^(i-1): 0.5 halves it every pass as in Dammertz et al. "
                                "(sigma_rt 2^-i), 1 keeps it constant"));
@@ -60,6 +62,7 @@ const FilterInfo& AtrousFilter::static_info() {
         "keep their precision";
     i.sweep_param = "iterations";
     i.sweep_values = {1, 2, 3, 4, 5, 6};
+    i.sweep_variants = {"colour_weight=noise firefly_k=2"};
     return i;
   }();
   return info;
@@ -109,6 +112,11 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
   pass.colour_weight = guides.colour;
   pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
   pass.colour_a_const = guides.colour_a_const;
+  if (guides.colour && params_.get_enum("colour_weight") == "noise") {  // filters/noise_weight.h
+    const Pass* spp = frame.find(Role::SampleCount);
+    noise_relative_colour_a(colour, spp ? &spp->image : nullptr, guides, nthreads, noise_a_);
+    pass.colour_a = noise_a_.data();
+  }
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
   const int bh = box.height();
   for (int i = 1; i <= iterations; ++i) {

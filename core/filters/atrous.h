@@ -26,6 +26,7 @@ class AtrousFilter : public Filter {
   ColourPlanes cp_;
   Guides guides_;
   std::vector<float> next_[3], next_ok_, valid_;
+  std::vector<float> noise_a_;  // colour_weight=noise: per-pixel sqrt(k) of the colour weight
 };
 
 }  // namespace mcr

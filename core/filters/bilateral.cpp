@@ -6,6 +6,7 @@
 #include "filters/feature_weights.h"
 #include "filters/foveation.h"
 #include "filters/gaussian.h"
+#include "filters/noise_weight.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -20,6 +21,7 @@ ParamTable bilateral_params() {
                      "window half width in pixels; 0 = ceil(3 spatial_sigma) at each pixel (follows foveation)"),
   };
   for (ParamSpec& s : feature_params()) t.push_back(s);
+  t.push_back(colour_weight_param());
   t.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
                                "firefly clamp: > 0 clamps every colour channel to [-clamp, clamp] before filtering; "
                                "0 = off (the colour weight alone keeps fireflies from spreading)"));
@@ -47,6 +49,7 @@ const FilterInfo& BilateralFilter::static_info() {
         "scaled by an exact power of two while summing, so sums never overflow and tiny values keep their precision";
     i.sweep_param = "spatial_sigma";
     i.sweep_values = {1, 2, 3, 4};
+    i.sweep_variants = {"colour_weight=noise firefly_k=2"};
     return i;
   }();
   return info;
@@ -122,6 +125,11 @@ void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& ro
   pass.colour_weight = guides.colour;
   pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
   pass.colour_a_const = guides.colour_a_const;
+  if (guides.colour && params_.get_enum("colour_weight") == "noise") {  // filters/noise_weight.h
+    const Pass* spp = frame.find(Role::SampleCount);
+    noise_relative_colour_a(colour, spp ? &spp->image : nullptr, guides, nthreads, noise_a_);
+    pass.colour_a = noise_a_.data();
+  }
   pass.colour_amul = 1.0f / cp.scale;  // the colour planes are scaled
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
   pass.s = s.empty() ? nullptr : s.data();

@@ -23,6 +23,7 @@ class BilateralFilter : public Filter {
   ColourPlanes cp_;
   Guides guides_;
   std::vector<float> valid_, s_, rad_, res_[3];
+  std::vector<float> noise_a_;  // colour_weight=noise: per-pixel sqrt(k) of the colour weight
 };
 
 }  // namespace mcr

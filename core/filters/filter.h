@@ -23,6 +23,9 @@ struct FilterInfo {
   // The main parameter and the values the run-time-against-error benchmark sweeps.
   std::string sweep_param;
   std::vector<double> sweep_values;
+  // Further settings ("key=value key=value") the benchmark sweeps the main parameter under,
+  // besides the defaults and firefly_k=2 (which every filter gets).
+  std::vector<std::string> sweep_variants;
 };
 
 // Parameters every filter's table ends with; the base class applies them
@@ -33,6 +36,8 @@ struct FilterInfo {
 //   holes        pixels the render did not sample, filled by pull-push (features too)
 //                before filtering: auto (sample_count == 0 when that pass exists),
 //                none, sample_count, alpha (alpha == 0)
+//   firefly_k, firefly_radius  bright outliers clamped to their window's
+//                statistics before filtering (filters/fireflies.h); 0 = off
 ParamTable with_common_params(ParamTable own);
 
 struct ExecOptions {
