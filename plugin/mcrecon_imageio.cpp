@@ -28,6 +28,7 @@
 #include "history.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
+#include "io/spec_window.h"
 #include "pipeline/denoise_file.h"
 #include "request.h"
 #include "util/error.h"
@@ -156,21 +157,13 @@ class McreconInput final : public ImageInput {
       const ImageSpec src = source_header(source);
       width = src.width;
       height = src.height;
-      window = {src.x, src.y, src.full_x, src.full_y, src.full_width, src.full_height};
+      window = mcr::window_of(src);
     } catch (const std::exception& e) {
       deferred_error_ = message(e);
     }
     // The layout write_result gives `mcrecon denoise` output: R,G,B,A float.
     m_spec = ImageSpec(width, height, 4, TypeFloat);
-    // The source's data and display windows, as `mcrecon denoise` writes them.
-    m_spec.x = window.x;
-    m_spec.y = window.y;
-    if (window.full_width > 0 && window.full_height > 0) {
-      m_spec.full_x = window.full_x;
-      m_spec.full_y = window.full_y;
-      m_spec.full_width = window.full_width;
-      m_spec.full_height = window.full_height;
-    }
+    mcr::set_window(m_spec, window);  // the source's, as `mcrecon denoise` writes them
     m_spec.channelnames = {"R", "G", "B", "A"};
     m_spec.alpha_channel = 3;
     m_spec.attribute("Software", "mcrecon");
@@ -367,7 +360,7 @@ class McreconOutput final : public ImageOutput {
       std::vector<std::string> names(m_spec.channelnames.begin(), m_spec.channelnames.end());
       mcr::Frame frame = mcr::frame_from_channels(shown_name_, m_spec.width, m_spec.height, names,
                                                   std::move(pixels_), request_.read);
-      frame.window = {m_spec.x, m_spec.y, m_spec.full_x, m_spec.full_y, m_spec.full_width, m_spec.full_height};
+      frame.window = mcr::window_of(m_spec);
       const mcr::Image rgb = run_filter(request_, settings_, shown_name_, frame);
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;

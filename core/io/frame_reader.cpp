@@ -10,6 +10,7 @@
 #include <set>
 
 #include "io/channel_roles.h"
+#include "io/spec_window.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -55,10 +56,6 @@ void check_spec(const ImageSpec& spec, const std::string& path) {
   if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || bytes > 32e9)
     throw Error(Errc::ReadFailed, "cannot read '" + path + "': implausible size " + std::to_string(spec.width) +
                                       "x" + std::to_string(spec.height) + "x" + std::to_string(spec.nchannels));
-}
-
-PixelWindow window_of(const ImageSpec& spec) {
-  return {spec.x, spec.y, spec.full_x, spec.full_y, spec.full_width, spec.full_height};
 }
 
 std::string part_label(const ImageSpec& spec, int part) {

@@ -5,6 +5,7 @@
 #include <set>
 
 #include "io/atomic_write.h"
+#include "io/spec_window.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -49,15 +50,7 @@ void write_result(const std::string& path, const Image& rgb, const Frame& input,
   ImageSpec spec(input.width, input.height, nc, TypeFloat);
   spec.channelnames = names;
   spec.alpha_channel = 3;
-  const PixelWindow& w = input.window;
-  spec.x = w.x;
-  spec.y = w.y;
-  if (w.full_width > 0 && w.full_height > 0) {
-    spec.full_x = w.full_x;
-    spec.full_y = w.full_y;
-    spec.full_width = w.full_width;
-    spec.full_height = w.full_height;
-  }
+  set_window(spec, input.window);
   spec.attribute("compression", options.compression);
   spec.attribute("Software", "mcrecon");
   for (const auto& kv : options.attributes) spec.attribute(kv.first, kv.second);
