@@ -161,6 +161,15 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       float* al = albedo_.data();
       const float* co = colour.data();
       const float* ad = ai.data();
+      if (ach == 3) {  // the usual RGB albedo: one flat, vectorisable loop
+        for (std::size_t j = b * 3; j < e * 3; ++j) {
+          const float v = ad[j];
+          const float a = (v - v == 0.0f) ? std::max(v, lo) : 1.0f;  // v - v: NaN for NaN/Inf
+          al[j] = a;
+          il[j] = co[j] / a;
+        }
+        return;
+      }
       for (std::size_t i = b; i < e; ++i)
         for (int c = 0; c < 3; ++c) {
           const float v = ad[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];

@@ -1,6 +1,8 @@
 // BMFR phase II: per-block least-squares fit of the accumulated illumination to the
 // multi-order features (Koskela et al. 2019, 4.2), one task per block.
 #include <algorithm>
+#include <array>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 
@@ -28,6 +30,58 @@ std::uint64_t splitmix(std::uint64_t& s) {
   z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
   z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
   return z ^ (z >> 31);
+}
+
+// xorshift64 (13, 7, 17) is linear over GF(2): the state k steps ahead is a 64 x 64 bit
+// matrix times the state. kNoiseLane steps ahead, as the images of the 64 unit vectors.
+constexpr std::size_t kNoiseLane = 256, kNoiseLanes = 4, kNoiseGroup = kNoiseLane * kNoiseLanes;
+
+inline std::uint64_t xorshift_step(std::uint64_t x) {
+  x ^= x << 13;
+  x ^= x >> 7;
+  x ^= x << 17;
+  return x;
+}
+
+const std::array<std::uint64_t, 64>& noise_jump() {
+  static const std::array<std::uint64_t, 64> jump = [] {
+    std::array<std::uint64_t, 64> j{};
+    for (int b = 0; b < 64; ++b) {
+      std::uint64_t x = std::uint64_t(1) << b;
+      for (std::size_t k = 0; k < kNoiseLane; ++k) x = xorshift_step(x);
+      j[std::size_t(b)] = x;
+    }
+    return j;
+  }();
+  return jump;
+}
+
+inline std::uint64_t jump_ahead(const std::array<std::uint64_t, 64>& j, std::uint64_t x) {
+  std::uint64_t r0 = 0, r1 = 0;
+  for (int b = 0; b < 64; b += 2) {
+    r0 ^= j[std::size_t(b)] & (std::uint64_t(0) - ((x >> b) & 1u));
+    r1 ^= j[std::size_t(b + 1)] & (std::uint64_t(0) - ((x >> (b + 1)) & 1u));
+  }
+  return r0 ^ r1;
+}
+
+// out[k] = the state after k + 1 steps from xs, k < n (n a multiple of kNoiseGroup): the
+// serial sequence, made kNoiseLanes chains at a time (lane l starts l * kNoiseLane
+// steps ahead).
+void xorshift_stream(std::uint64_t xs, std::uint64_t* out, std::size_t n) {
+  const auto& j = noise_jump();
+  for (std::size_t g = 0; g < n; g += kNoiseGroup) {
+    std::uint64_t s[kNoiseLanes];
+    s[0] = xs;
+    for (std::size_t l = 1; l < kNoiseLanes; ++l) s[l] = jump_ahead(j, s[l - 1]);
+    std::uint64_t* o = out + g;
+    for (std::size_t k = 0; k < kNoiseLane; ++k)
+      for (std::size_t l = 0; l < kNoiseLanes; ++l) {
+        s[l] = xorshift_step(s[l]);
+        o[l * kNoiseLane + k] = s[l];
+      }
+    xs = s[kNoiseLanes - 1];
+  }
 }
 
 // Raw (unscaled) feature channels per feature set. The fitted columns are then
@@ -101,6 +155,12 @@ void scale_masked(const float* src, const float* mask, int np, float lo, float s
   }
 }
 
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
+#define MCR_FIT_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define MCR_FIT_CLONES
+#endif
+
 struct FitScratch {
   std::vector<float> raw;    // R columns x np, planar
   std::vector<float> feat;   // M columns x np, planar, scaled, noise-free
@@ -109,8 +169,212 @@ struct FitScratch {
   std::vector<int> rows;
   std::vector<double> mat;   // W x (M + 3), column-major
   std::vector<double> acc;   // 3 x np synthesis
+  std::vector<std::uint64_t> noise;  // regularisation noise stream
   AugmentedQr qr;
 };
+
+// Everything one block needs (read-only), for fit_block().
+struct FitJob {
+  int w, h, B, ox, oy, nbx, R, M, pch, nch;
+  FeatureLayout lay;
+  double eps;
+  std::uint64_t seed;
+  std::int64_t frame_index;
+  bool clamp_max;
+  const Image *pos, *nrm, *alb, *dep;
+  const Image* illum;
+  const float* valid;
+  Image* fitted;
+};
+
+// Fits block b. Built for AVX2 as well (picked at load time): no FMA, so the same
+// operations and the same results as the baseline build.
+MCR_FIT_CLONES
+void fit_block(const FitJob& J, FitScratch& S, int b) {
+  const int w = J.w, h = J.h, B = J.B, ox = J.ox, oy = J.oy, nbx = J.nbx, R = J.R, M = J.M, pch = J.pch, nch = J.nch;
+  const FeatureLayout& lay = J.lay;
+  const double eps = J.eps;
+  const std::uint64_t seed = J.seed;
+  const std::int64_t frame_index_ = J.frame_index;
+  const bool clamp_max = J.clamp_max;
+  const Image &pos = *J.pos, &nrm = *J.nrm, &illum = *J.illum;
+  const Image *alb = J.alb, *dep = J.dep;
+  const float* valid = J.valid;
+  Image& fitted = *J.fitted;
+  (void)h;
+  const int by = b / nbx, bx = b % nbx;
+  const int x0 = std::max(0, bx * B - ox), x1 = std::min(w, (bx + 1) * B - ox);
+  const int y0 = std::max(0, by * B - oy), y1 = std::min(h, (by + 1) * B - oy);
+  if (x1 <= x0 || y1 <= y0) return;
+  const int bw = x1 - x0, np = bw * (y1 - y0);
+  const std::size_t snp = std::size_t(np);
+  float* raw = S.raw.data();
+  float* feat = S.feat.data();
+  float* fin = S.fin.data();  // 1: every feature finite, 0: not
+  float* zp = S.z.data();     // accumulated illumination, 3 planar columns
+  int* rows = S.rows.data();
+  // Raw features and the illumination, planar, in one sweep over the block's rows; a
+  // pixel with any non-finite feature is left out of the fit and its features read as
+  // mid-range (0 after scaling). Fitted rows: finite features and a valid colour.
+  int p = 0, W = 0;
+  for (int y = y0; y < y1; ++y) {
+    const std::size_t rb = std::size_t(y) * std::size_t(w) + std::size_t(x0);
+    const float* nrow = nrm.data() + rb * std::size_t(nch);
+    const float* prow = pos.data() + rb * std::size_t(pch);
+    const float* irow = illum.data() + rb * 3;
+    const float* vrow = valid + rb;
+    for (int x = 0; x < bw; ++x, ++p) {
+      const float* n = nrow + std::size_t(x) * std::size_t(nch);
+      const float* q = prow + std::size_t(x) * std::size_t(pch);
+      const float v[6] = {n[0], n[1], n[2], q[0], q[1], q[2]};
+      float f = 0.0f;  // x - x: 0 for finite x, NaN otherwise
+      for (int c = 0; c < 6; ++c) {
+        raw[std::size_t(c) * snp + std::size_t(p)] = v[c];
+        f += v[c] - v[c];
+      }
+      int k = 6;
+      if (alb) {
+        const float* a = alb->pixel(x0 + x, y);
+        for (int c = 0; c < 3; ++c, ++k) {
+          const float t = a[std::min(c, alb->channels() - 1)];
+          raw[std::size_t(k) * snp + std::size_t(p)] = t;
+          f += t - t;
+        }
+      }
+      if (dep) {
+        const float t = dep->pixel(x0 + x, y)[0];
+        raw[std::size_t(k) * snp + std::size_t(p)] = t;
+        f += t - t;
+      }
+      const bool ok = f == 0.0f;
+      fin[p] = ok ? 1.0f : 0.0f;
+      for (int c = 0; c < 3; ++c) zp[std::size_t(c) * snp + std::size_t(p)] = irow[std::size_t(x) * 3 + std::size_t(c)];
+      rows[W] = p;
+      W += (ok && vrow[x] > 0.0f) ? 1 : 0;
+    }
+  }
+  // Scaled to [-1, 1] over the block's finite pixels; a column constant within float
+  // rounding is 0 (the constant column carries it).
+  auto scale_column = [&](const float* src, float* dst) {
+    float lo, hi;
+    masked_min_max(src, fin, np, lo, hi);
+    const double range = double(hi) - double(lo);
+    if (!(range > 1e-5 * std::max(std::fabs(double(lo)), std::fabs(double(hi)))) || !(range > 1e-30) ||
+        !std::isfinite(range)) {
+      std::fill(dst, dst + np, 0.0f);
+      return;
+    }
+    scale_masked(src, fin, np, lo, float(2.0 / range), dst);
+  };
+  std::fill(feat, feat + np, 1.0f);
+  // Columns: 0 constant; 1..3 normal; 4..6 position; [7..9 position^2]; extras.
+  for (int c = 0; c < R; ++c) {
+    const int col = c < 6 ? 1 + c : 1 + c + (lay.squares ? 3 : 0);
+    scale_column(raw + std::size_t(c) * snp, feat + std::size_t(col) * snp);
+  }
+  if (lay.squares)
+    for (int c = 0; c < 3; ++c) {
+      // Square of the scaled position: the same span as w^2 with w, better conditioned.
+      float* sq = raw;  // raw column 0 is no longer needed: reuse as scratch
+      const float* s0 = feat + std::size_t(4 + c) * snp;
+      for (int i = 0; i < np; ++i) sq[i] = s0[i] * s0[i];
+      scale_column(sq, feat + std::size_t(7 + c) * snp);
+    }
+  if (W == 0) {
+    for (int y = y0; y < y1; ++y) {
+      float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
+      std::fill(o, o + std::size_t(bw) * 3, std::numeric_limits<float>::quiet_NaN());
+    }
+    return;
+  }
+  double* mat = S.mat.data();
+  const std::size_t sW = std::size_t(W);
+  std::uint64_t rng = seed * 0x2545F4914F6CDD1Dull ^ (std::uint64_t(frame_index_) << 32) ^
+                      (std::uint64_t(by) * 65537u + std::uint64_t(bx) + 1);
+  // Per-block noise stream: xorshift64 seeded by splitmix of (seed, frame, block),
+  // two 32-bit uniforms in [-1, 1) per step (plenty for a regulariser).
+  std::uint64_t xs = splitmix(rng) | 1u;
+  const bool dense = W == np;  // every pixel fitted: rows[r] == r
+  for (int r = 0; r < W; ++r) mat[r] = 1.0;  // no noise on the constant: a constant block stays exact
+  // The noise goes on the fitted features only, never on the synthesis ones. The
+  // stream is one xorshift64 sequence over the columns, ceil(W/2) steps per column
+  // (low half to row r, high half to row r + 1; an odd last row takes the high half),
+  // generated ahead in 4 interleaved lanes by jump-ahead (the same values).
+  const double e31 = eps * (1.0 / 2147483648.0);
+  const std::size_t hs = (sW + 1) / 2;
+  const std::uint64_t* nz = nullptr;
+  if (eps > 0) {
+    const std::size_t steps = hs * std::size_t(M - 1);
+    const std::size_t need = (steps + kNoiseGroup - 1) / kNoiseGroup * kNoiseGroup;
+    if (S.noise.size() < need) S.noise.resize(need);
+    xorshift_stream(xs, S.noise.data(), need);
+    nz = S.noise.data();
+  }
+  for (int m = 1; m < M; ++m) {
+    double* col = mat + std::size_t(m) * sW;
+    const float* fm = feat + std::size_t(m) * snp;
+    if (dense)
+      for (int r = 0; r < W; ++r) col[r] = double(fm[r]);
+    else
+      for (int r = 0; r < W; ++r) col[r] = double(fm[rows[r]]);
+    if (nz) {
+      const std::uint64_t* q = nz + std::size_t(m - 1) * hs;
+      int r = 0;
+      for (; r + 2 <= W; r += 2) {
+        const std::uint64_t v = q[r >> 1];
+        col[r] += e31 * double(std::int32_t(std::uint32_t(v)));
+        col[r + 1] += e31 * double(std::int32_t(std::uint32_t(v >> 32)));
+      }
+      if (r < W) col[r] += e31 * double(std::int32_t(std::uint32_t(q[r >> 1] >> 32)));
+    }
+  }
+  double zmin[3], zmax[3];
+  for (int c = 0; c < 3; ++c) {
+    double* col = mat + std::size_t(M + c) * sW;
+    const float* zc = zp + std::size_t(c) * snp;
+    float zm = INFINITY, zx = -INFINITY;
+    for (int r = 0; r < W; ++r) {
+      const float z = zc[rows[r]];
+      col[r] = double(z);
+      zm = std::min(zm, z);
+      zx = std::max(zx, z);
+    }
+    zmin[c] = double(zm);
+    zmax[c] = double(zx);
+  }
+  S.qr.factorize(mat, W, M, 3);
+  double alpha[3][32];
+  for (int c = 0; c < 3; ++c) S.qr.solve(c, alpha[c]);
+  // Synthesis with the noise-free features (planar, vectorised over the pixels).
+  double* acc = S.acc.data();
+  for (int c = 0; c < 3; ++c) {
+    double* ac = acc + std::size_t(c) * snp;
+    const double a0 = alpha[c][0];
+    for (int i = 0; i < np; ++i) ac[i] = a0;
+    for (int m = 1; m < M; ++m) {
+      const double am = alpha[c][m];
+      if (am == 0.0) continue;
+      const float* fm = feat + std::size_t(m) * snp;
+      for (int i = 0; i < np; ++i) ac[i] += am * double(fm[i]);
+    }
+  }
+  const double zlo[3] = {std::min(0.0, zmin[0]), std::min(0.0, zmin[1]), std::min(0.0, zmin[2])};
+  const double zhi[3] = {std::max(0.0, zmax[0]), std::max(0.0, zmax[1]), std::max(0.0, zmax[2])};
+  for (int y = y0, i = 0; y < y1; ++y) {
+    float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
+    for (int x = 0; x < bw; ++x, ++i)
+      for (int c = 0; c < 3; ++c) {
+        // Radiance is not negative: no fit below min(0, the block's smallest input).
+        // Nor above the block's largest input: an ill-conditioned fit extrapolating at
+        // the pixels it was not fitted on (invalid ones, partial edge blocks) cannot
+        // make a highlight brighter than anything it was given.
+        double v = std::max(acc[std::size_t(c) * snp + std::size_t(i)], zlo[c]);
+        if (clamp_max) v = std::min(v, zhi[c]);
+        o[std::size_t(x) * 3 + std::size_t(c)] =
+            std::isfinite(v) ? float(std::clamp(v, -kFloatMax, kFloatMax)) : std::numeric_limits<float>::quiet_NaN();
+      }
+  }
+}
 
 }  // namespace
 
@@ -142,6 +406,8 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   // One task per block (rows of blocks would leave a thread idle on the last ones); the
   // result of a block depends on (seed, frame, block) only.
   const int nblocks = nbx * nby;
+  FitJob job{w, h, B, ox, oy, nbx, R, M, pch, nch, lay, eps, seed, frame_index_, clamp_max, &pos, &nrm, alb, dep, &illum,
+             valid.data(), &fitted};
   tbb::task_arena arena(arena_threads(nthreads));
   tbb::enumerable_thread_specific<FitScratch> scratch;
   arena.execute([&] {
@@ -157,172 +423,7 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
         S.acc.resize(cap * 3);
       }
       for (int b = range.begin(); b != range.end(); ++b) {
-        const int by = b / nbx, bx = b % nbx;
-        const int x0 = std::max(0, bx * B - ox), x1 = std::min(w, (bx + 1) * B - ox);
-        const int y0 = std::max(0, by * B - oy), y1 = std::min(h, (by + 1) * B - oy);
-        if (x1 <= x0 || y1 <= y0) continue;
-        const int bw = x1 - x0, np = bw * (y1 - y0);
-        const std::size_t snp = std::size_t(np);
-        float* raw = S.raw.data();
-        float* feat = S.feat.data();
-        float* fin = S.fin.data();  // 1: every feature finite, 0: not
-        float* zp = S.z.data();     // accumulated illumination, 3 planar columns
-        int* rows = S.rows.data();
-        // Raw features and the illumination, planar, in one sweep over the block's rows; a
-        // pixel with any non-finite feature is left out of the fit and its features read as
-        // mid-range (0 after scaling). Fitted rows: finite features and a valid colour.
-        int p = 0, W = 0;
-        for (int y = y0; y < y1; ++y) {
-          const std::size_t rb = std::size_t(y) * std::size_t(w) + std::size_t(x0);
-          const float* nrow = nrm.data() + rb * std::size_t(nch);
-          const float* prow = pos.data() + rb * std::size_t(pch);
-          const float* irow = illum.data() + rb * 3;
-          const float* vrow = valid.data() + rb;
-          for (int x = 0; x < bw; ++x, ++p) {
-            const float* n = nrow + std::size_t(x) * std::size_t(nch);
-            const float* q = prow + std::size_t(x) * std::size_t(pch);
-            const float v[6] = {n[0], n[1], n[2], q[0], q[1], q[2]};
-            float f = 0.0f;  // x - x: 0 for finite x, NaN otherwise
-            for (int c = 0; c < 6; ++c) {
-              raw[std::size_t(c) * snp + std::size_t(p)] = v[c];
-              f += v[c] - v[c];
-            }
-            int k = 6;
-            if (alb) {
-              const float* a = alb->pixel(x0 + x, y);
-              for (int c = 0; c < 3; ++c, ++k) {
-                const float t = a[std::min(c, alb->channels() - 1)];
-                raw[std::size_t(k) * snp + std::size_t(p)] = t;
-                f += t - t;
-              }
-            }
-            if (dep) {
-              const float t = dep->pixel(x0 + x, y)[0];
-              raw[std::size_t(k) * snp + std::size_t(p)] = t;
-              f += t - t;
-            }
-            const bool ok = f == 0.0f;
-            fin[p] = ok ? 1.0f : 0.0f;
-            for (int c = 0; c < 3; ++c) zp[std::size_t(c) * snp + std::size_t(p)] = irow[std::size_t(x) * 3 + std::size_t(c)];
-            rows[W] = p;
-            W += (ok && vrow[x] > 0.0f) ? 1 : 0;
-          }
-        }
-        // Scaled to [-1, 1] over the block's finite pixels; a column constant within float
-        // rounding is 0 (the constant column carries it).
-        auto scale_column = [&](const float* src, float* dst) {
-          float lo, hi;
-          masked_min_max(src, fin, np, lo, hi);
-          const double range = double(hi) - double(lo);
-          if (!(range > 1e-5 * std::max(std::fabs(double(lo)), std::fabs(double(hi)))) || !(range > 1e-30) ||
-              !std::isfinite(range)) {
-            std::fill(dst, dst + np, 0.0f);
-            return;
-          }
-          scale_masked(src, fin, np, lo, float(2.0 / range), dst);
-        };
-        std::fill(feat, feat + np, 1.0f);
-        // Columns: 0 constant; 1..3 normal; 4..6 position; [7..9 position^2]; extras.
-        for (int c = 0; c < R; ++c) {
-          const int col = c < 6 ? 1 + c : 1 + c + (lay.squares ? 3 : 0);
-          scale_column(raw + std::size_t(c) * snp, feat + std::size_t(col) * snp);
-        }
-        if (lay.squares)
-          for (int c = 0; c < 3; ++c) {
-            // Square of the scaled position: the same span as w^2 with w, better conditioned.
-            float* sq = raw;  // raw column 0 is no longer needed: reuse as scratch
-            const float* s0 = feat + std::size_t(4 + c) * snp;
-            for (int i = 0; i < np; ++i) sq[i] = s0[i] * s0[i];
-            scale_column(sq, feat + std::size_t(7 + c) * snp);
-          }
-        if (W == 0) {
-          for (int y = y0; y < y1; ++y) {
-            float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
-            std::fill(o, o + std::size_t(bw) * 3, std::numeric_limits<float>::quiet_NaN());
-          }
-          continue;
-        }
-        double* mat = S.mat.data();
-        const std::size_t sW = std::size_t(W);
-        std::uint64_t rng = seed * 0x2545F4914F6CDD1Dull ^ (std::uint64_t(frame_index_) << 32) ^
-                            (std::uint64_t(by) * 65537u + std::uint64_t(bx) + 1);
-        // Per-block noise stream: xorshift64 seeded by splitmix of (seed, frame, block),
-        // two 32-bit uniforms in [-1, 1) per step (plenty for a regulariser).
-        std::uint64_t xs = splitmix(rng) | 1u;
-        const bool dense = W == np;  // every pixel fitted: rows[r] == r
-        for (int r = 0; r < W; ++r) mat[r] = 1.0;  // no noise on the constant: a constant block stays exact
-        // The noise goes on the fitted features only, never on the synthesis ones.
-        const double e31 = eps * (1.0 / 2147483648.0);
-        for (int m = 1; m < M; ++m) {
-          double* col = mat + std::size_t(m) * sW;
-          const float* fm = feat + std::size_t(m) * snp;
-          if (dense)
-            for (int r = 0; r < W; ++r) col[r] = double(fm[r]);
-          else
-            for (int r = 0; r < W; ++r) col[r] = double(fm[rows[r]]);
-          if (eps > 0) {
-            int r = 0;
-            for (; r + 2 <= W; r += 2) {
-              xs ^= xs << 13;
-              xs ^= xs >> 7;
-              xs ^= xs << 17;
-              col[r] += e31 * double(std::int32_t(std::uint32_t(xs)));
-              col[r + 1] += e31 * double(std::int32_t(std::uint32_t(xs >> 32)));
-            }
-            if (r < W) {
-              xs ^= xs << 13;
-              xs ^= xs >> 7;
-              xs ^= xs << 17;
-              col[r] += e31 * double(std::int32_t(std::uint32_t(xs >> 32)));
-            }
-          }
-        }
-        double zmin[3], zmax[3];
-        for (int c = 0; c < 3; ++c) {
-          double* col = mat + std::size_t(M + c) * sW;
-          const float* zc = zp + std::size_t(c) * snp;
-          float zm = INFINITY, zx = -INFINITY;
-          for (int r = 0; r < W; ++r) {
-            const float z = zc[rows[r]];
-            col[r] = double(z);
-            zm = std::min(zm, z);
-            zx = std::max(zx, z);
-          }
-          zmin[c] = double(zm);
-          zmax[c] = double(zx);
-        }
-        S.qr.factorize(mat, W, M, 3);
-        double alpha[3][32];
-        for (int c = 0; c < 3; ++c) S.qr.solve(c, alpha[c]);
-        // Synthesis with the noise-free features (planar, vectorised over the pixels).
-        double* acc = S.acc.data();
-        for (int c = 0; c < 3; ++c) {
-          double* ac = acc + std::size_t(c) * snp;
-          const double a0 = alpha[c][0];
-          for (int i = 0; i < np; ++i) ac[i] = a0;
-          for (int m = 1; m < M; ++m) {
-            const double am = alpha[c][m];
-            if (am == 0.0) continue;
-            const float* fm = feat + std::size_t(m) * snp;
-            for (int i = 0; i < np; ++i) ac[i] += am * double(fm[i]);
-          }
-        }
-        const double zlo[3] = {std::min(0.0, zmin[0]), std::min(0.0, zmin[1]), std::min(0.0, zmin[2])};
-        const double zhi[3] = {std::max(0.0, zmax[0]), std::max(0.0, zmax[1]), std::max(0.0, zmax[2])};
-        for (int y = y0, i = 0; y < y1; ++y) {
-          float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
-          for (int x = 0; x < bw; ++x, ++i)
-            for (int c = 0; c < 3; ++c) {
-              // Radiance is not negative: no fit below min(0, the block's smallest input).
-              // Nor above the block's largest input: an ill-conditioned fit extrapolating at
-              // the pixels it was not fitted on (invalid ones, partial edge blocks) cannot
-              // make a highlight brighter than anything it was given.
-              double v = std::max(acc[std::size_t(c) * snp + std::size_t(i)], zlo[c]);
-              if (clamp_max) v = std::min(v, zhi[c]);
-              o[std::size_t(x) * 3 + std::size_t(c)] =
-                  std::isfinite(v) ? float(std::clamp(v, -kFloatMax, kFloatMax)) : std::numeric_limits<float>::quiet_NaN();
-            }
-        }
+        fit_block(job, S, b);
       }
     });
   });
