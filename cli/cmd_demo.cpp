@@ -69,8 +69,6 @@ int run_demo(const DemoArgs& a) {
         rows.push_back({scene.name, std::to_string(spp * 4) + "spp", "(noisy)", evaluate(more, nullptr, a.threads)});
         print_row(rows.back(), false);
       }
-      std::vector<const Image*> tiles = {&rows.front().ev.preview};
-      std::string legend = "noisy " + input;
       for (const auto& name : filters) {
         auto filter = make_filter(name);
         filter->commit();
@@ -81,6 +79,9 @@ int run_demo(const DemoArgs& a) {
         rows.push_back(std::move(row));
         print_row(rows.back(), true);
       }
+      // Pointers into `rows` only now that it has stopped growing.
+      std::vector<const Image*> tiles = {&rows.front().ev.preview};
+      std::string legend = "noisy " + input;
       for (const Row& r : rows)
         if (r.filter != "(noisy)") {
           tiles.push_back(&r.ev.preview);
