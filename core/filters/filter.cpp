@@ -159,28 +159,23 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   // row-parallel pass; the per-row counts are added in row order.
   std::vector<std::size_t> row_repaired(std::size_t(std::max(h, 0)), 0);
   const std::size_t rw = std::size_t(w) * 3;
-  if (out.storage().size() == rw * std::size_t(h))
-    parallel_rows(0, h, nthreads, [&](int y) {
-      float* o = out.data() + std::size_t(y) * rw;
-      if (!albedo.empty()) {
-        const float* al = albedo.data() + std::size_t(y) * rw;
-        for (std::size_t i = 0; i < rw; ++i) o[i] *= al[i];
-      }
-      // Branch-free scan first: almost every row is finite.
-      bool all = true;
-      for (std::size_t i = 0; i < rw; ++i) all &= std::fabs(o[i]) <= 3.402823466e38f;
-      if (all) return;
-      std::size_t n = 0;
-      for (std::size_t i = 0; i < rw; ++i)
-        if (!std::isfinite(o[i])) { o[i] = 0.0f; ++n; }
-      row_repaired[std::size_t(y)] = n;
-    });
-  else {  // a filter that resized its output (none does): the plain loops
-    if (!albedo.empty())
-      for (std::size_t i = 0; i < out.storage().size() && i < albedo.storage().size(); ++i) out.storage()[i] *= albedo.storage()[i];
-    for (float& v : out.storage())
-      if (!std::isfinite(v)) { v = 0.0f; ++row_repaired[0]; }
-  }
+  if (out.storage().size() != rw * std::size_t(h))
+    throw Error(Errc::Internal, "filter '" + info_.name + "' returned an output of another size");
+  parallel_rows(0, h, nthreads, [&](int y) {
+    float* o = out.data() + std::size_t(y) * rw;
+    if (!albedo.empty()) {
+      const float* al = albedo.data() + std::size_t(y) * rw;
+      for (std::size_t i = 0; i < rw; ++i) o[i] *= al[i];
+    }
+    // Branch-free scan first: almost every row is finite.
+    bool all = true;
+    for (std::size_t i = 0; i < rw; ++i) all &= std::fabs(o[i]) <= 3.402823466e38f;
+    if (all) return;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < rw; ++i)
+      if (!std::isfinite(o[i])) { o[i] = 0.0f; ++n; }
+    row_repaired[std::size_t(y)] = n;
+  });
   repaired_ = 0;
   for (std::size_t v : row_repaired) repaired_ += v;
   if (repaired_) note(std::to_string(repaired_) + " non-finite output values replaced by 0");
