@@ -109,14 +109,7 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
 
   CrossPass pass;
   pass.pb = pb;
-  pass.colour_weight = guides.colour;
-  pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
-  pass.colour_a_const = guides.colour_a_const;
-  if (guides.colour && params_.get_enum("colour_weight") == "noise") {  // filters/noise_weight.h
-    const Pass* spp = frame.find(Role::SampleCount);
-    noise_relative_colour_a(colour, spp ? &spp->image : nullptr, guides, nthreads, noise_a_);
-    pass.colour_a = noise_a_.data();
-  }
+  set_colour_weight(pass, guides, params_, frame, colour, nthreads, noise_a_);
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
   const int bh = box.height();
   for (int i = 1; i <= iterations; ++i) {

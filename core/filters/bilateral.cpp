@@ -122,14 +122,7 @@ void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& ro
   for (int c = 0; c < 3; ++c) pass.colour[c] = cp.c[c].data();
   pass.colour_ok = cp.ok.data();
   pass.valid = valid.data();
-  pass.colour_weight = guides.colour;
-  pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
-  pass.colour_a_const = guides.colour_a_const;
-  if (guides.colour && params_.get_enum("colour_weight") == "noise") {  // filters/noise_weight.h
-    const Pass* spp = frame.find(Role::SampleCount);
-    noise_relative_colour_a(colour, spp ? &spp->image : nullptr, guides, nthreads, noise_a_);
-    pass.colour_a = noise_a_.data();
-  }
+  set_colour_weight(pass, guides, params_, frame, colour, nthreads, noise_a_);
   pass.colour_amul = 1.0f / cp.scale;  // the colour planes are scaled
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
   pass.s = s.empty() ? nullptr : s.data();

@@ -74,4 +74,16 @@ void noise_relative_colour_a(const Image& colour, const Image* sample_count, con
   });
 }
 
+void set_colour_weight(CrossPass& pass, const Guides& guides, const ParamSet& params, const Frame& frame,
+                       const Image& colour, int nthreads, std::vector<float>& scratch) {
+  pass.colour_weight = guides.colour;
+  pass.colour_a = guides.colour_a.empty() ? nullptr : guides.colour_a.data();
+  pass.colour_a_const = guides.colour_a_const;
+  if (guides.colour && params.get_enum("colour_weight") == "noise") {
+    const Pass* spp = frame.find(Role::SampleCount);
+    noise_relative_colour_a(colour, spp ? &spp->image : nullptr, guides, nthreads, scratch);
+    pass.colour_a = scratch.data();
+  }
+}
+
 }  // namespace mcr

@@ -26,6 +26,7 @@
 #include "filters/feature_weights.h"
 #include "filters/params.h"
 #include "image/image.h"
+#include "image/pass.h"
 
 namespace mcr {
 
@@ -41,5 +42,10 @@ std::vector<double> noise_variance(const Image& colour, const Image* sample_coun
 // g.colour_a_const) / s(p), clamped to [0, 1e18] (finite). Fills `a`, reusing its memory.
 void noise_relative_colour_a(const Image& colour, const Image* sample_count, const Guides& g, int nthreads,
                              std::vector<float>& a);
+
+// The colour weight of a CrossPass from `guides`, made noise-relative when the
+// filter's colour_weight parameter says so (the plane is kept in `scratch`).
+void set_colour_weight(CrossPass& pass, const Guides& guides, const ParamSet& params, const Frame& frame,
+                       const Image& colour, int nthreads, std::vector<float>& scratch);
 
 }  // namespace mcr
