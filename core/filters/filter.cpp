@@ -12,11 +12,11 @@ namespace mcr {
 
 ParamTable with_common_params(ParamTable own) {
   own.push_back(ParamSpec::Bool("demodulate", false, "divide the colour by the albedo pass before filtering and multiply after"));
-  own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0, "albedo is clamped to [albedo_floor, 1] for demodulation"));
+  own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0, "albedo is raised to at least albedo_floor for demodulation (no upper clamp: colour is divided and multiplied by the same value, and Blender's albedo exceeds 1 on highlights)"));
   own.push_back(ParamSpec::Enum("holes", "auto", {"auto", "none", "sample_count", "alpha"},
                                 "unsampled pixels to fill by pull-push first: auto = sample_count 0 when that pass exists"));
   own.push_back(ParamSpec::Float("firefly_k", 0.0, 0.0, 1e3,
-                                 "firefly suppression before filtering (and before demodulation): a pixel whose luminance "
+                                 "firefly suppression before filtering (after demodulation, on the illumination): a pixel whose luminance "
                                  "exceeds mu + max(k sd, 0.01 |mu|) of its window's other pixels is scaled down to that "
                                  "limit (Guo & Pan 2012, 3.3, clamping instead of replacing); 0 = off"));
   own.push_back(ParamSpec::Int("firefly_radius", 3, 1, 8, "half width of the firefly statistics window"));
@@ -116,13 +116,8 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     });
   }
 
-  // Firefly suppression, on the radiance as rendered (before demodulation).
-  if (params_.get_float("firefly_k") > 0) {
-    std::size_t clamped = 0;
-    colour = suppress_fireflies(colour, int(params_.get_int("firefly_radius")), params_.get_float("firefly_k"),
-                                options.nthreads, &clamped);
-    note("firefly suppression clamped " + std::to_string(clamped) + " pixels");
-  }
+  Roi roi = options.roi.empty() ? Roi::all(frame.width, frame.height) : options.roi.clipped(frame.width, frame.height);
+  if (roi.empty()) return colour;  // nothing to filter: the input as it is
 
   // Albedo demodulation: filter the illumination, not the texture.
   Image albedo;
@@ -137,15 +132,22 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
       for (std::size_t i = b; i < e; ++i)
         for (int c = 0; c < 3; ++c) {
           const float v = a->image.data()[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];
-          const float al = std::isfinite(v) ? std::clamp(v, lo, 1.0f) : 1.0f;
+          const float al = std::isfinite(v) ? std::max(v, lo) : 1.0f;
           albedo.data()[i * 3 + std::size_t(c)] = al;
           colour.data()[i * 3 + std::size_t(c)] /= al;
         }
     });
   }
 
-  Roi roi = options.roi.empty() ? Roi::all(frame.width, frame.height) : options.roi.clipped(frame.width, frame.height);
-  if (roi.empty()) return colour;
+  // Firefly suppression, after demodulation: on the illumination a texture edge is not an
+  // outlier, and a firefly stands out of its window more clearly (glossy: 0.0099 -> 0.0090).
+  if (params_.get_float("firefly_k") > 0) {
+    std::size_t clamped = 0;
+    colour = suppress_fireflies(colour, int(params_.get_int("firefly_radius")), params_.get_float("firefly_k"),
+                                options.nthreads, &clamped);
+    note("firefly suppression clamped " + std::to_string(clamped) + " pixels");
+  }
+
   Image out;
   if (run_in_place()) {
     run(*src, colour, roi, colour, nthreads);

@@ -125,6 +125,26 @@ TEST(FilterStress, ZeroAlbedoWithDemodulation) {
   }
 }
 
+TEST(FilterStress, RegionOutsideTheFrameKeepsTheInput) {
+  // An empty region filters nothing: the colour comes back as rendered, not demodulated or
+  // firefly-suppressed.
+  for (const std::string& name : filter_names()) {
+    if (make_filter(name)->info().temporal) continue;
+    const Frame f = full_frame(18, 13, 7);
+    auto filter = make_filter(name);
+    filter->set("demodulate", true);
+    filter->set("firefly_k", 2.0);
+    filter->commit();
+    ExecOptions o;
+    o.roi = Roi{40, 40, 50, 50};
+    const Image out = filter->execute(f, o);
+    const Image& in = f.image(Role::Colour);
+    for (int y = 0; y < f.height; ++y)
+      for (int x = 0; x < f.width; ++x)
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(out.at(x, y, c), in.at(x, y, c)) << name << " at " << x << "," << y;
+  }
+}
+
 TEST(FilterStress, AllEqualFeaturesAndFireflies) {
   for (const std::string& name : filter_names()) {
     Frame f = full_frame(24, 24, 7);

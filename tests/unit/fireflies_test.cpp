@@ -113,5 +113,31 @@ TEST(Fireflies, AppliedBeforeTheFilter) {
   EXPECT_NE(out.at(4, 4, 0), b->execute(f).at(4, 4, 0));
 }
 
+TEST(Fireflies, AfterDemodulationATextureEdgeIsNoOutlier) {
+  // A bright texel (albedo 0.9 among 0.05) under constant light 0.8: its radiance stands
+  // 18x above its window, but its illumination does not, so with demodulate=true nothing is
+  // clamped and the box (of a constant illumination) gives back light x albedo everywhere.
+  // A spike in the light itself (at 2,2) is still clamped.
+  Image albedo = grey(9, 9, 0.05f);
+  set_rgb(albedo, 4, 4, 0.9f, 0.9f, 0.9f);
+  Image colour(9, 9, 3);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 0; x < 9; ++x)
+      for (int c = 0; c < 3; ++c) colour.at(x, y, c) = 0.8f * albedo.at(x, y, c);
+  colour.at(2, 2, 0) = colour.at(2, 2, 1) = colour.at(2, 2, 2) = 0.05f * 40.0f;
+  Frame f = testutil::colour_frame(colour);
+  testutil::add_pass(f, Role::Albedo, albedo);
+  auto box = make_filter("box");
+  box->set("radius", 0);  // identity: only suppression and (de)modulation act
+  box->set("demodulate", true);
+  box->set("firefly_k", 2.0);
+  box->commit();
+  const Image out = box->execute(f);
+  for (int c = 0; c < 3; ++c) {
+    EXPECT_NEAR(out.at(4, 4, c), 0.8f * 0.9f, 1e-6f);
+    EXPECT_LT(out.at(2, 2, c), 0.05f * 2.0f);
+  }
+}
+
 }  // namespace
 }  // namespace mcr
