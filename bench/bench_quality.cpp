@@ -1,6 +1,6 @@
 // Run time against error on the sample scenes: every registered filter, a sweep
 // of its main parameter (FilterInfo::sweep_param), with and without albedo
-// demodulation, under the defaults, firefly_k=2 and the filter's sweep_variants,
+// demodulation, under the defaults, firefly_k=2, firefly_k=1 and the filter's sweep_variants,
 // against the noisy input and the same scene at 4x the samples.
 //   mcrecon_bench_quality [--spp 16] [--scenes room,glossy] [--filters a,b] [--threads N] [--json FILE]
 #include <cstdio>
@@ -82,7 +82,7 @@ int main(int argc, char** argv) {
         Best best{"", {}};
         best.ev.metrics.relmse = 1e300;
         // Variants: the defaults, firefly suppression (a common parameter), the filter's own.
-        std::vector<std::string> variants = {"", "firefly_k=2"};
+        std::vector<std::string> variants = {"", "firefly_k=2", "firefly_k=1"};
         for (const std::string& v : info.sweep_variants) variants.push_back(v);
         for (const std::string& variant : variants)
         for (bool demod : {false, true}) {
