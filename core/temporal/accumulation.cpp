@@ -10,7 +10,7 @@
 
 #include "util/error.h"
 #include "util/parallel.h"
-#include "util/rgb8_avx2.h"
+#include "util/avx2_shuffles.h"
 
 namespace mcr {
 

@@ -2,10 +2,12 @@
 
 #include <cmath>
 
+#include "temporal/reprojection.h"
+
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #include <immintrin.h>
 
-#include "util/rgb8_avx2.h"
+#include "util/avx2_shuffles.h"
 
 namespace mcr::detail {
 
@@ -41,10 +43,6 @@ __attribute__((target("avx2"), always_inline)) inline __m256 finite3(const V3& p
   return _mm256_cmp_ps(s, _mm256_setzero_ps(), _CMP_EQ_OQ);
 }
 
-__attribute__((target("avx2"), always_inline)) inline __m256 gather_masked(const float* base, __m256i idx, __m256 on) {
-  return _mm256_mask_i32gather_ps(_mm256_setzero_ps(), base, idx, on, 4);
-}
-
 // 0 <= v < n, as a lane mask.
 __attribute__((target("avx2"), always_inline)) inline __m256i in_range(__m256i v, __m256i n) {
   return _mm256_andnot_si256(_mm256_cmpgt_epi32(_mm256_setzero_si256(), v), _mm256_cmpgt_epi32(n, v));
@@ -60,7 +58,7 @@ __attribute__((target("avx2"))) std::size_t tap_row_avx2(const TapRow& a, int x0
   const __m256 thr2 = _mm256_set1_ps(a.thr2), cs2 = _mm256_set1_ps(a.cs2), eps6 = _mm256_set1_ps(1e-6f);
   const bool cs_pos = a.cs >= 0;
   const __m256i iw = _mm256_set1_epi32(w), ih = _mm256_set1_epi32(h), ione = _mm256_set1_epi32(1),
-                three = _mm256_set1_epi32(3), lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+                lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i mstride = _mm256_mullo_epi32(lane, _mm256_set1_epi32(a.mch));
   const bool up = y > 0, down = y + 1 < h;
   std::size_t lost = 0;
@@ -70,8 +68,15 @@ __attribute__((target("avx2"))) std::size_t tap_row_avx2(const TapRow& a, int x0
     __m256 py = _mm256_set1_ps(float(y));
     if (a.mrow) {
       const float* m = a.mrow + std::size_t(x) * std::size_t(a.mch);
-      px = _mm256_add_ps(px, _mm256_i32gather_ps(m, mstride, 4));
-      py = _mm256_sub_ps(py, _mm256_i32gather_ps(m + 1, mstride, 4));
+      __m256 mx, my;
+      if (a.mch == 4) {
+        load_xy4x8(m, mx, my);
+      } else {
+        mx = _mm256_i32gather_ps(m, mstride, 4);
+        my = _mm256_i32gather_ps(m + 1, mstride, 4);
+      }
+      px = _mm256_add_ps(px, mx);
+      py = _mm256_sub_ps(py, my);
     }
     const __m256 near = _mm256_and_ps(_mm256_cmp_ps(_mm256_andnot_ps(sign, px), big, _CMP_LE_OQ),
                                       _mm256_cmp_ps(_mm256_andnot_ps(sign, py), big, _CMP_LE_OQ));
@@ -89,12 +94,23 @@ __attribute__((target("avx2"))) std::size_t tap_row_avx2(const TapRow& a, int x0
                             _mm256_and_si256(cx1, cy1)};
     __m256i in = _mm256_setzero_si256();
     for (int k = 0; k < 4; ++k) in = _mm256_or_si256(in, _mm256_and_si256(ink[k], _mm256_set1_epi32(1 << k)));
-    const __m256 ncl = _mm256_loadu_ps(a.cinfo + x);
+    // This pixel's record: the squared normal length where position and normal are finite.
+    const V3 pc = load3(a.prow + std::size_t(x) * 3), nc = load3(a.nrow + std::size_t(x) * 3);
+    __m256 ncl;
+    {
+      const __m256 fin = _mm256_and_ps(finite3(pc), finite3(nc));
+      const __m256 l =
+          _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(nc.x, nc.x), _mm256_mul_ps(nc.y, nc.y)), _mm256_mul_ps(nc.z, nc.z));
+      ncl = _mm256_blendv_ps(_mm256_set1_ps(NAN), l, fin);
+      __m256 rec[8] = {pc.x, pc.y, pc.z, nc.x, nc.y, nc.z, ncl, zero};
+      transpose8(rec);
+      float* g = a.grow + std::size_t(x) * kGeoRecord;
+      for (int l8 = 0; l8 < 8; ++l8) _mm256_storeu_ps(g + l8 * kGeoRecord, rec[l8]);
+    }
     const __m256 live = _mm256_and_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(in, _mm256_setzero_si256())),
                                       _mm256_cmp_ps(ncl, ncl, _CMP_ORD_Q));
     __m256i mask = _mm256_setzero_si256();
     if (!_mm256_testz_ps(live, live)) {
-      const V3 pc = load3(a.prow + std::size_t(x) * 3);
       __m256 limit = thr2;
       if (a.relative) {
         // Footprint: larger of the horizontal and vertical distance to the nearer finite
@@ -122,24 +138,23 @@ __attribute__((target("avx2"))) std::size_t tap_row_avx2(const TapRow& a, int x0
         const __m256 fl = _mm256_mul_ps(eps6, _mm256_add_ps(one, _mm256_sqrt_ps(len2)));
         limit = _mm256_max_ps(_mm256_mul_ps(fl, fl), limit);  // std::max(limit, fl * fl)
       }
-      const V3 nc = load3(a.nrow + std::size_t(x) * 3);
       const __m256 cbg = _mm256_cmp_ps(ncl, eps6, _CMP_LT_OQ);
       const __m256i t0 = _mm256_add_epi32(_mm256_mullo_epi32(iy, iw), ix);
       const __m256i off[4] = {_mm256_setzero_si256(), ione, iw, _mm256_add_epi32(iw, ione)};
       for (int k = 0; k < 4; ++k) {
         const __m256 on = _mm256_and_ps(live, _mm256_castsi256_ps(ink[k]));
         if (_mm256_testz_ps(on, on)) continue;
-        const __m256i ti = _mm256_add_epi32(t0, off[k]), t3 = _mm256_mullo_epi32(ti, three);
-        const __m256 npl = gather_masked(a.hinfo, ti, on);
+        // The tap's record per lane (lanes off read pixel 0), transposed to planes.
+        const __m256i ti = _mm256_and_si256(_mm256_add_epi32(t0, off[k]), _mm256_castps_si256(on));
+        alignas(32) int idx[8];
+        _mm256_store_si256(reinterpret_cast<__m256i*>(idx), ti);
+        __m256 rec[8];
+        for (int l8 = 0; l8 < 8; ++l8) rec[l8] = _mm256_loadu_ps(a.hgeo + std::size_t(idx[l8]) * kGeoRecord);
+        transpose8(rec);
+        const V3 pp{rec[0], rec[1], rec[2]}, np{rec[3], rec[4], rec[5]};
+        const __m256 npl = rec[6];
         const __m256 use = _mm256_and_ps(on, _mm256_cmp_ps(npl, npl, _CMP_ORD_Q));
-        V3 pp, np;
-        pp.x = gather_masked(a.hp, t3, use);
-        pp.y = gather_masked(a.hp + 1, t3, use);
-        pp.z = gather_masked(a.hp + 2, t3, use);
         __m256 ok = _mm256_and_ps(use, _mm256_cmp_ps(dist2(pc, pp), limit, _CMP_LE_OQ));
-        np.x = gather_masked(a.hn, t3, ok);
-        np.y = gather_masked(a.hn + 1, t3, ok);
-        np.z = gather_masked(a.hn + 2, t3, ok);
         const __m256 pbg = _mm256_cmp_ps(npl, eps6, _CMP_LT_OQ);
         // cos >= cs without square roots: d >= cs |a||b|; both background: agree.
         const __m256 d =

@@ -12,10 +12,10 @@ struct TapRow {
   int w, h, y;
   const float* prow;           // current position, row y (row y-1 / y+1 at -/+ 3w when they exist)
   const float* nrow;           // current normal, row y
-  const float* cinfo;          // current squared normal length (NaN: non-finite), row y
+  float* grow;                 // out: row y of the packed geometry records (kGeoRecord floats per pixel)
   const float* mrow;           // motion row (nullptr: none), mch channels
   int mch;
-  const float *hp, *hn, *hinfo;  // previous frame: position, normal, info (whole frame)
+  const float* hgeo;           // previous frame's packed records (whole frame)
   float thr2, cs, cs2;
   bool relative;
   float* prev_x;  // row y of the outputs
@@ -27,7 +27,7 @@ struct TapRow {
 // Whether this CPU runs tap_row_avx2().
 bool tap_row_avx2_available();
 // Pixels [x0, x1) of the row, 1 <= x0, x1 <= w - 1 (the horizontal neighbours exist),
-// x1 - x0 a multiple of 8. Returns the pixels with no kept tap. The same float operations
+// x1 - x0 a multiple of 8: their records and tests. Returns the pixels with no kept tap. The same float operations
 // in the same order as the scalar loop: the same results bit for bit.
 std::size_t tap_row_avx2(const TapRow& a, int x0, int x1);
 
