@@ -15,6 +15,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#include "util/avx2_shuffles.h"
 
 namespace mcr {
 
@@ -161,6 +162,47 @@ void scale_masked(const float* src, const float* mask, int np, float lo, float s
 #define MCR_FIT_CLONES
 #endif
 
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_FIT_GATHER_AVX2 1
+bool has_avx2() {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+  }();
+  return yes;
+}
+
+// The default feature set's gather (normal and position, 3 channels each, no extras) of
+// block row y for pixels [0, n8), n8 a multiple of 8, p the first pixel's index in the
+// block: the loop in fit_block 8 pixels at a time (the same values; deinterleaved by
+// shuffles). Returns the new count of fitted rows.
+__attribute__((target("avx2"))) int gather_row_avx2(const float* nrow, const float* prow, const float* irow,
+                                                     const float* vrow, int n8, int p, std::size_t snp, float* raw,
+                                                     float* fin, float* zp, int* rows, int W) {
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  for (int x = 0; x < n8; x += 8, p += 8) {
+    __m256 v[6], z[3];
+    load_rgb8(nrow + std::size_t(x) * 3, v[0], v[1], v[2]);
+    load_rgb8(prow + std::size_t(x) * 3, v[3], v[4], v[5]);
+    load_rgb8(irow + std::size_t(x) * 3, z[0], z[1], z[2]);
+    __m256 f = zero;  // 0 where all six are finite, NaN otherwise
+    for (int c = 0; c < 6; ++c) {
+      _mm256_storeu_ps(raw + std::size_t(c) * snp + std::size_t(p), v[c]);
+      f = _mm256_add_ps(f, _mm256_sub_ps(v[c], v[c]));
+    }
+    const __m256 ok = _mm256_cmp_ps(f, zero, _CMP_EQ_OQ);
+    _mm256_storeu_ps(fin + p, _mm256_and_ps(ok, one));
+    for (int c = 0; c < 3; ++c) _mm256_storeu_ps(zp + std::size_t(c) * snp + std::size_t(p), z[c]);
+    const int fit = _mm256_movemask_ps(_mm256_and_ps(ok, _mm256_cmp_ps(_mm256_loadu_ps(vrow + x), zero, _CMP_GT_OQ)));
+    for (int l = 0; l < 8; ++l) {
+      rows[W] = p + l;
+      W += (fit >> l) & 1;
+    }
+  }
+  return W;
+}
+#endif
+
 struct FitScratch {
   std::vector<float> raw;    // R columns x np, planar
   std::vector<float> feat;   // M columns x np, planar, scaled, noise-free
@@ -223,7 +265,15 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     const float* prow = pos.data() + rb * std::size_t(pch);
     const float* irow = illum.data() + rb * 3;
     const float* vrow = valid + rb;
-    for (int x = 0; x < bw; ++x, ++p) {
+    int x = 0;
+#ifdef MCR_FIT_GATHER_AVX2
+    if (!alb && !dep && pch == 3 && nch == 3 && has_avx2()) {
+      x = bw / 8 * 8;
+      W = gather_row_avx2(nrow, prow, irow, vrow, x, p, snp, raw, fin, zp, rows, W);
+      p += x;
+    }
+#endif
+    for (; x < bw; ++x, ++p) {
       const float* n = nrow + std::size_t(x) * std::size_t(nch);
       const float* q = prow + std::size_t(x) * std::size_t(pch);
       const float v[6] = {n[0], n[1], n[2], q[0], q[1], q[2]};
@@ -310,22 +360,29 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     xorshift_stream(xs, S.noise.data(), need);
     nz = S.noise.data();
   }
+  // Step r >> 1 gives row r its low half (r even) or high half (r odd): on a
+  // little-endian machine that is 32-bit word r of the stream, a loop the compiler
+  // vectorises (int32 -> double conversions).
+  typedef std::int32_t noise_word __attribute__((__may_alias__));
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "noise words assume little endian");
+  const int even = W & ~1;
   for (int m = 1; m < M; ++m) {
     double* col = mat + std::size_t(m) * sW;
     const float* fm = feat + std::size_t(m) * snp;
-    if (dense)
+    const noise_word* q = nz ? reinterpret_cast<const noise_word*>(nz + std::size_t(m - 1) * hs) : nullptr;
+    if (dense && q)
+      for (int r = 0; r < even; ++r) col[r] = double(fm[r]) + e31 * double(q[r]);
+    else if (dense)
       for (int r = 0; r < W; ++r) col[r] = double(fm[r]);
     else
       for (int r = 0; r < W; ++r) col[r] = double(fm[rows[r]]);
-    if (nz) {
-      const std::uint64_t* q = nz + std::size_t(m - 1) * hs;
-      int r = 0;
-      for (; r + 2 <= W; r += 2) {
-        const std::uint64_t v = q[r >> 1];
-        col[r] += e31 * double(std::int32_t(std::uint32_t(v)));
-        col[r + 1] += e31 * double(std::int32_t(std::uint32_t(v >> 32)));
+    if (q) {
+      if (!dense)
+        for (int r = 0; r < even; ++r) col[r] += e31 * double(q[r]);
+      if (even < W) {  // odd last row: the high half of its step
+        if (dense) col[even] = double(fm[even]);
+        col[even] += e31 * double(q[even + 1]);
       }
-      if (r < W) col[r] += e31 * double(std::int32_t(std::uint32_t(q[r >> 1] >> 32)));
     }
   }
   double zmin[3], zmax[3];
@@ -333,11 +390,37 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     double* col = mat + std::size_t(M + c) * sW;
     const float* zc = zp + std::size_t(c) * snp;
     float zm = INFINITY, zx = -INFINITY;
-    for (int r = 0; r < W; ++r) {
-      const float z = zc[rows[r]];
-      col[r] = double(z);
-      zm = std::min(zm, z);
-      zx = std::max(zx, z);
+    if (dense) {
+      // 8 running minima and maxima (min and max do not depend on the order; NaN is
+      // skipped either way), so the loop vectorises.
+      float m8[8], x8[8];
+      std::fill(m8, m8 + 8, INFINITY);
+      std::fill(x8, x8 + 8, -INFINITY);
+      int r = 0;
+      for (; r + 8 <= W; r += 8)
+        for (int l = 0; l < 8; ++l) {
+          const float z = zc[r + l];
+          col[r + l] = double(z);
+          m8[l] = z < m8[l] ? z : m8[l];
+          x8[l] = x8[l] < z ? z : x8[l];
+        }
+      for (int l = 0; l < 8; ++l) {
+        zm = std::min(zm, m8[l]);
+        zx = std::max(zx, x8[l]);
+      }
+      for (; r < W; ++r) {
+        const float z = zc[r];
+        col[r] = double(z);
+        zm = std::min(zm, z);
+        zx = std::max(zx, z);
+      }
+    } else {
+      for (int r = 0; r < W; ++r) {
+        const float z = zc[rows[r]];
+        col[r] = double(z);
+        zm = std::min(zm, z);
+        zx = std::max(zx, z);
+      }
     }
     zmin[c] = double(zm);
     zmax[c] = double(zx);
