@@ -15,6 +15,7 @@
 #include <limits>
 
 #include "filters/bmfr.h"
+#include "filters/bmfr_taa_avx2.h"
 #include "util/parallel.h"
 
 #if defined(__SSE2__)
@@ -185,6 +186,7 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
   const float* H = taa_hist_.data();
   float* N = taa_next_.data();
   const int ox0 = roi.x0, ox1 = roi.x1;
+  const bool avx2 = detail::taa_avx2_available();
 
   parallel_rows(0, h, nthreads, [&](int y) {
     thread_local TaaRow T;
@@ -206,6 +208,14 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
         mx = std::max(v0, std::max(v1, v2));
       };
       int x = 0;
+      if (avx2) {
+        float* const s3[3] = {cs0, cs1, cs2};
+        float* const q3[3] = {cq0, cq1, cq2};
+        float* const n3[3] = {mn0, mn1, mn2};
+        float* const x3[3] = {mx0, mx1, mx2};
+        float* const u3[3] = {cu0, cu1, cu2};
+        x = detail::taa_stats_avx2(x, w, ycocg, R, G, Bc, r0, r1, r2, s3, q3, n3, x3, u3);
+      }
 #if defined(__SSE2__)
       {
         // std::min(v0, std::min(v1, v2)) = _mm_min_ps(_mm_min_ps(v2, v1), v0), same for max.
@@ -286,7 +296,7 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
       const float* cur = T.cur[k];
       float* blo = T.lo[k];
       float* bhi = T.hi[k];
-      int x = 0;
+      int x = avx2 ? detail::taa_box_avx2(0, w, ycocg, gamma, cs, cq, cmn, cmx, cur, blo, bhi) : 0;
 #if defined(__SSE2__)
       const __m128 ninth = _mm_set1_ps(1.0f / 9.0f), g4 = _mm_set1_ps(gamma), zero = _mm_setzero_ps();
       for (; x + 4 <= w; x += 4) {
@@ -359,6 +369,12 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
       float* ng = nr + n;
       float* nb = ng + n;
       int x = 0;
+      if (avx2) {
+        const float* const hv3[3] = {h0, h1, h2};
+        const float* const lo3[3] = {lo0, lo1, lo2};
+        const float* const hi3[3] = {hi0, hi1, hi2};
+        x = detail::taa_clip_avx2(x, w, ycocg, a, hv3, okr, lo3, hi3, cr, cg, cb, nr, ng, nb);
+      }
 #if defined(__SSE2__)
       {
         const __m128 q4 = _mm_set1_ps(0.25f), h2 = _mm_set1_ps(0.5f), mq4 = _mm_set1_ps(-0.25f);
