@@ -117,6 +117,7 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
   const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f),
                tiny = _mm256_set1_ps(1e-6f), afv = _mm256_set1_ps(af), cmax = _mm256_set1_ps(65535.0f);
   const __m256i iw = _mm256_set1_epi32(w), three = _mm256_set1_epi32(3);
+  const __m256i last8 = _mm256_set1_epi32(int(std::size_t(w) * std::size_t(r.height)) - 3);
   const __m256i off[4] = {_mm256_setzero_si256(), _mm256_set1_epi32(1), iw, _mm256_set1_epi32(w + 1)};
   int x = 0;
   for (; x + 8 <= w; x += 8) {
@@ -141,23 +142,45 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
       const __m256 wt[4] = {_mm256_mul_ps(gx, gy), _mm256_mul_ps(fx, gy), _mm256_mul_ps(gx, fy), _mm256_mul_ps(fx, fy)};
       const __m256i t0 = _mm256_add_epi32(_mm256_mullo_epi32(y0, iw), x0);
       __m256 sum = zero, cnt = zero;
-      for (int k = 0; k < 4; ++k) {
-        const __m256i bit = _mm256_set1_epi32(1 << k);
-        const __m256 on = _mm256_and_ps(
-            _mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(mask, bit), bit)), _mm256_cmp_ps(wt[k], zero, _CMP_GT_OQ));
-        if (_mm256_testz_ps(on, on)) continue;
+      // Taps in pairs (k, k + 1) on one history row: per lane one 8-float load covers
+      // both taps' RGB (a transpose makes them planes); the counts are gathered.
+      for (int k = 0; k < 4; k += 2) {
+        __m256 on[2];
+        for (int j = 0; j < 2; ++j) {
+          const __m256i bit = _mm256_set1_epi32(1 << (k + j));
+          on[j] = _mm256_and_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(mask, bit), bit)),
+                                _mm256_cmp_ps(wt[k + j], zero, _CMP_GT_OQ));
+        }
+        const __m256 any = _mm256_or_ps(on[0], on[1]);
+        if (_mm256_testz_ps(any, any)) continue;
         const __m256i t = _mm256_add_epi32(t0, off[k]);
-        const __m256 tc = _mm256_mask_i32gather_ps(zero, hcount, t, on, 4);
-        const __m256 use = _mm256_and_ps(on, _mm256_cmp_ps(tc, zero, _CMP_GT_OQ));
-        const __m256i t3 = _mm256_mullo_epi32(t, three);
-        const __m256 v0 = _mm256_mask_i32gather_ps(zero, hist, t3, use, 4);
-        const __m256 v1 = _mm256_mask_i32gather_ps(zero, hist + 1, t3, use, 4);
-        const __m256 v2 = _mm256_mask_i32gather_ps(zero, hist + 2, t3, use, 4);
-        sum = _mm256_blendv_ps(sum, _mm256_add_ps(sum, wt[k]), use);
-        cnt = _mm256_blendv_ps(cnt, _mm256_add_ps(cnt, _mm256_mul_ps(wt[k], tc)), use);
-        h0 = _mm256_blendv_ps(h0, _mm256_add_ps(h0, _mm256_mul_ps(wt[k], v0)), use);
-        h1 = _mm256_blendv_ps(h1, _mm256_add_ps(h1, _mm256_mul_ps(wt[k], v1)), use);
-        h2 = _mm256_blendv_ps(h2, _mm256_add_ps(h2, _mm256_mul_ps(wt[k], v2)), use);
+        const __m256 tc[2] = {_mm256_mask_i32gather_ps(zero, hcount, t, on[0], 4),
+                              _mm256_mask_i32gather_ps(zero, hcount, _mm256_add_epi32(t, off[1]), on[1], 4)};
+        const __m256 use[2] = {_mm256_and_ps(on[0], _mm256_cmp_ps(tc[0], zero, _CMP_GT_OQ)),
+                               _mm256_and_ps(on[1], _mm256_cmp_ps(tc[1], zero, _CMP_GT_OQ))};
+        __m256 v[8];
+        const __m256i ti = _mm256_and_si256(t, _mm256_castps_si256(any));  // lanes off read pixel 0
+        // 8 floats from pixel ti stay inside the image up to ti = n - 3; past that (the
+        // last two pixels) the taps are gathered.
+        if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(ti, last8))) == 0) {
+          alignas(32) int idx[8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(idx), ti);
+          for (int l = 0; l < 8; ++l) v[l] = _mm256_loadu_ps(hist + std::size_t(idx[l]) * 3);
+          transpose8(v);
+        } else {
+          for (int j = 0; j < 2; ++j) {
+            const __m256i t3 = _mm256_mullo_epi32(_mm256_add_epi32(t, off[j]), three);
+            for (int c = 0; c < 3; ++c) v[3 * j + c] = _mm256_mask_i32gather_ps(zero, hist + c, t3, use[j], 4);
+          }
+        }
+        for (int j = 0; j < 2; ++j) {
+          const __m256 wk = wt[k + j], u = use[j];
+          sum = _mm256_blendv_ps(sum, _mm256_add_ps(sum, wk), u);
+          cnt = _mm256_blendv_ps(cnt, _mm256_add_ps(cnt, _mm256_mul_ps(wk, tc[j])), u);
+          h0 = _mm256_blendv_ps(h0, _mm256_add_ps(h0, _mm256_mul_ps(wk, v[3 * j])), u);
+          h1 = _mm256_blendv_ps(h1, _mm256_add_ps(h1, _mm256_mul_ps(wk, v[3 * j + 1])), u);
+          h2 = _mm256_blendv_ps(h2, _mm256_add_ps(h2, _mm256_mul_ps(wk, v[3 * j + 2])), u);
+        }
       }
       have = _mm256_cmp_ps(sum, tiny, _CMP_GT_OQ);
       const __m256 inv = _mm256_div_ps(one, sum);
