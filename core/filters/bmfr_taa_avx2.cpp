@@ -2,6 +2,8 @@
 
 #include <limits>
 
+#include "filters/bmfr_taa_cr.h"
+
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #include <immintrin.h>
 
@@ -168,6 +170,86 @@ __attribute__((target("avx2"))) int taa_clip_avx2(int x, int w, bool ycocg, floa
   return x;
 }
 
+__attribute__((target("avx2"))) void taa_lookup_cr_avx2(int w, int h, std::size_t n, const float* H, const float* px,
+                                                        const float* py, const std::uint8_t* inside, float* h0,
+                                                        float* h1, float* h2, float* okr) {
+  // Per pixel: whether it has a history sample, and for an interior one (no clamped tap)
+  // its weights and the first tap.
+  struct Tap {
+    bool ok, interior;
+    float wx[4], wy[4];
+    const float* base;
+  };
+  auto prepare = [&](int x, Tap& t) {
+    t.ok = t.interior = false;
+    const float fx = px[x], fy = py[x];
+    if (!inside[x] || !(fx >= -0.5f && fy >= -0.5f && fx <= float(w) - 0.5f && fy <= float(h) - 0.5f)) return;
+    t.ok = true;
+    const int ix = floor_int(fx), iy = floor_int(fy);
+    const int bx = ix - 1, by = iy - 1;
+    if (!(bx >= 0 && by >= 0 && bx + 3 < w && by + 3 < h)) return;
+    t.interior = true;
+    cr_weights(fx - float(ix), t.wx);
+    cr_weights(fy - float(iy), t.wy);
+    t.base = H + std::size_t(by) * std::size_t(w) + std::size_t(bx);
+  };
+  auto single = [&](int x) {
+    float hv[3] = {0, 0, 0};
+    const bool ok = inside[x] && catmull_rom_planar(H, w, h, n, px[x], py[x], hv);
+    h0[x] = hv[0];
+    h1[x] = hv[1];
+    h2[x] = hv[2];
+    okr[x] = ok ? 1.0f : 0.0f;
+  };
+  int x = 0;
+  for (; x + 2 <= w; x += 2) {
+    Tap a, b;
+    prepare(x, a);
+    prepare(x + 1, b);
+    if (!(a.interior && b.interior)) {
+      single(x);
+      single(x + 1);
+      continue;
+    }
+    // Two pixels side by side, pixel x in the low 128-bit half: per half, the
+    // operations of catmull_rom_planar's SSE2 path.
+    const __m256 wy[4] = {_mm256_setr_m128(_mm_set1_ps(a.wy[0]), _mm_set1_ps(b.wy[0])),
+                          _mm256_setr_m128(_mm_set1_ps(a.wy[1]), _mm_set1_ps(b.wy[1])),
+                          _mm256_setr_m128(_mm_set1_ps(a.wy[2]), _mm_set1_ps(b.wy[2])),
+                          _mm256_setr_m128(_mm_set1_ps(a.wy[3]), _mm_set1_ps(b.wy[3]))};
+    const __m256 wx = _mm256_setr_m128(_mm_loadu_ps(a.wx), _mm_loadu_ps(b.wx));
+    __m256 acc[3];
+    for (int c = 0; c < 3; ++c) {
+      const float* pa = a.base + std::size_t(c) * n;
+      const float* pb = b.base + std::size_t(c) * n;
+      __m256 s = _mm256_mul_ps(wy[0], _mm256_loadu2_m128(pb, pa));
+      for (int j = 1; j < 4; ++j) {
+        const std::size_t o = std::size_t(j) * std::size_t(w);
+        s = _mm256_add_ps(s, _mm256_mul_ps(wy[j], _mm256_loadu2_m128(pb + o, pa + o)));
+      }
+      acc[c] = _mm256_mul_ps(s, wx);
+    }
+    // _MM_TRANSPOSE4_PS per half, the fourth row 0; then (r0 + r1) + (r2 + r3).
+    const __m256 zero = _mm256_setzero_ps();
+    const __m256 t0 = _mm256_unpacklo_ps(acc[0], acc[1]), t2 = _mm256_unpacklo_ps(acc[2], zero);
+    const __m256 t1 = _mm256_unpackhi_ps(acc[0], acc[1]), t3 = _mm256_unpackhi_ps(acc[2], zero);
+    const __m256 r0 = _mm256_shuffle_ps(t0, t2, 0x44), r1 = _mm256_shuffle_ps(t0, t2, 0xEE);
+    const __m256 r2 = _mm256_shuffle_ps(t1, t3, 0x44), r3 = _mm256_shuffle_ps(t1, t3, 0xEE);
+    const __m256 sum = _mm256_add_ps(_mm256_add_ps(r0, r1), _mm256_add_ps(r2, r3));
+    alignas(32) float o8[8];
+    _mm256_store_ps(o8, sum);
+    h0[x] = o8[0];
+    h1[x] = o8[1];
+    h2[x] = o8[2];
+    okr[x] = 1.0f;
+    h0[x + 1] = o8[4];
+    h1[x + 1] = o8[5];
+    h2[x + 1] = o8[6];
+    okr[x + 1] = 1.0f;
+  }
+  for (; x < w; ++x) single(x);
+}
+
 }  // namespace mcr::detail
 
 #else
@@ -186,6 +268,8 @@ int taa_clip_avx2(int x, int, bool, float, const float* const*, const float*, co
                   const float*, const float*, const float*, float*, float*, float*) {
   return x;
 }
+void taa_lookup_cr_avx2(int, int, std::size_t, const float*, const float*, const float*, const std::uint8_t*, float*,
+                        float*, float*, float*) {}
 }  // namespace mcr::detail
 
 #endif

@@ -4,6 +4,7 @@
 // runs over [x, w) 8 pixels at a time and returns where it stopped; the callers' SSE2 and
 // scalar loops do the rest.
 #include <cstddef>
+#include <cstdint>
 
 namespace mcr::detail {
 
@@ -21,5 +22,11 @@ int taa_box_avx2(int x, int w, bool ycocg, float gamma, const float* cs, const f
 int taa_clip_avx2(int x, int w, bool ycocg, float a, const float* const hv[3], const float* okr, const float* const lo[3],
                   const float* const hi[3], const float* cr, const float* cg, const float* cb, float* nr, float* ng,
                   float* nb);
+
+// Step 3 with the Catmull-Rom history, a whole row (px, py, inside, outputs: that row):
+// two interior pixels at a time in the two 128-bit halves, the rest by
+// catmull_rom_planar().
+void taa_lookup_cr_avx2(int w, int h, std::size_t n, const float* H, const float* px, const float* py,
+                        const std::uint8_t* inside, float* h0, float* h1, float* h2, float* okr);
 
 }  // namespace mcr::detail
