@@ -10,7 +10,6 @@
 #include "linalg/householder_qr.h"
 #include "util/parallel.h"
 
-#include <tbb/enumerable_thread_specific.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
@@ -535,19 +534,22 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   FitJob job{w, h, B, ox, oy, nbx, R, M, pch, nch, lay, eps, seed, frame_index_, clamp_max, &pos, &nrm, alb, dep, &illum,
              valid.data(), &fitted};
   tbb::task_arena arena(arena_threads(nthreads));
-  tbb::enumerable_thread_specific<FitScratch> scratch;
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, nblocks, 1), [&](const tbb::blocked_range<int>& range) {
-      FitScratch& S = scratch.local();
-      if (S.fin.size() < cap) {
-        S.raw.resize(cap * std::size_t(R));
-        S.feat.resize(cap * std::size_t(M));
-        S.fin.resize(cap);
-        S.z.resize(cap * 3);
-        S.rows.resize(cap);
-        S.mat.resize(cap * std::size_t(M + 3));
-        S.acc.resize(cap * 3);
-      }
+      // Per thread, kept from frame to frame (a fresh scratch per frame was ~200 KB of
+      // new pages per thread and frame).
+      thread_local FitScratch S;
+      // Grown only (block size and feature set may change between calls).
+      auto grow = [](auto& v, std::size_t k) {
+        if (v.size() < k) v.resize(k);
+      };
+      grow(S.raw, cap * std::size_t(R));
+      grow(S.feat, cap * std::size_t(M));
+      grow(S.fin, cap);
+      grow(S.z, cap * 3);
+      grow(S.rows, cap);
+      grow(S.mat, cap * std::size_t(M + 3));
+      grow(S.acc, cap * 3);
       for (int b = range.begin(); b != range.end(); ++b) {
         fit_block(job, S, b);
       }
