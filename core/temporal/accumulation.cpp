@@ -118,6 +118,7 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
                tiny = _mm256_set1_ps(1e-6f), afv = _mm256_set1_ps(af), cmax = _mm256_set1_ps(65535.0f);
   const __m256i iw = _mm256_set1_epi32(w), three = _mm256_set1_epi32(3);
   const __m256i last8 = _mm256_set1_epi32(int(std::size_t(w) * std::size_t(r.height)) - 3);
+  const std::size_t last = std::size_t(w) * std::size_t(r.height) - 1;
   const __m256i off[4] = {_mm256_setzero_si256(), _mm256_set1_epi32(1), iw, _mm256_set1_epi32(w + 1)};
   int x = 0;
   for (; x + 8 <= w; x += 8) {
@@ -131,6 +132,16 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
     std::uint64_t m8 = 0;
     if (hist) std::memcpy(&m8, taps + x, 8);
     if (m8) {
+      // The history rows y and y + 1 some pixels ahead (taps follow the pixel for small
+      // motion): their first touch is otherwise a cache miss inside a gather.
+      const std::size_t ahead = std::min(rb + std::size_t(x) + 64, last);
+      const std::size_t below = std::min(ahead + std::size_t(w), last);
+      _mm_prefetch(reinterpret_cast<const char*>(hcount + ahead), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hcount + below), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + ahead * 3), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + ahead * 3 + 16), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + below * 3), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + below * 3 + 16), _MM_HINT_T0);
       const __m256i mask = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(m8)));
       const __m256 px = _mm256_loadu_ps(pxs + x), py = _mm256_loadu_ps(pys + x);
       // floor_int: truncate, minus one where that rounded up.
