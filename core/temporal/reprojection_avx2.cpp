@@ -1,5 +1,6 @@
 #include "temporal/reprojection_avx2.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "temporal/reprojection.h"
@@ -61,6 +62,7 @@ __attribute__((target("avx2"))) std::size_t tap_row_avx2(const TapRow& a, int x0
                 lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
   const __m256i mstride = _mm256_mullo_epi32(lane, _mm256_set1_epi32(a.mch));
   const bool up = y > 0, down = y + 1 < h;
+  const std::size_t last = std::size_t(w) * std::size_t(h) - 1;
   std::size_t lost = 0;
   for (int x = x0; x < x1; x += 8) {
     // Previous-frame position; non-finite or huge: far outside.
@@ -111,6 +113,16 @@ __attribute__((target("avx2"))) std::size_t tap_row_avx2(const TapRow& a, int x0
                                       _mm256_cmp_ps(ncl, ncl, _CMP_ORD_Q));
     __m256i mask = _mm256_setzero_si256();
     if (!_mm256_testz_ps(live, live)) {
+      // The history records of rows y and y + 1 some pixels ahead (taps follow the pixel
+      // for small motion): otherwise the first touch is a miss in the per-lane loads.
+      {
+        const std::size_t ahead = std::min(std::size_t(y) * std::size_t(w) + std::size_t(x) + 32, last);
+        const std::size_t below = std::min(ahead + std::size_t(w), last);
+        for (int l = 0; l < 4; ++l) {
+          _mm_prefetch(reinterpret_cast<const char*>(a.hgeo + ahead * kGeoRecord + 16 * l), _MM_HINT_T0);
+          _mm_prefetch(reinterpret_cast<const char*>(a.hgeo + below * kGeoRecord + 16 * l), _MM_HINT_T0);
+        }
+      }
       __m256 limit = thr2;
       if (a.relative) {
         // Footprint: larger of the horizontal and vertical distance to the nearer finite
