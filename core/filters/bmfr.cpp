@@ -7,6 +7,7 @@
 #include <limits>
 #include <ctime>
 
+#include "util/avx2_shuffles.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -122,6 +123,56 @@ namespace {
 void ensure_image(Image& im, int w, int h, int ch) {
   if (im.width() != w || im.height() != h || im.channels() != ch) im = Image(w, h, ch);
 }
+
+// Phase III's remodulation of one row into the planar result: r = clamp(s * a) (a = 1
+// without albedo), infinities to +-max, NaN kept. Returns the first pixel not done; the
+// AVX2 build does 8 pixels at a time (the same operations), the caller the rest.
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_BMFR_AVX2 1
+bool has_avx2() {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+  }();
+  return yes;
+}
+
+__attribute__((target("avx2"))) int remodulate_row_avx2(const float* s, const float* a, int w, float* r0, float* r1,
+                                                        float* r2) {
+  const __m256 lo = _mm256_set1_ps(-std::numeric_limits<float>::max()), hi = _mm256_set1_ps(std::numeric_limits<float>::max());
+  int x = 0;
+  for (; x + 8 <= w; x += 8) {
+    __m256 v[3];
+    load_rgb8(s + std::size_t(x) * 3, v[0], v[1], v[2]);
+    if (a) {
+      __m256 m[3];
+      load_rgb8(a + std::size_t(x) * 3, m[0], m[1], m[2]);
+      for (int c = 0; c < 3; ++c) v[c] = _mm256_mul_ps(v[c], m[c]);
+    }
+    // std::min(std::max(v, lo), hi): max_ps(lo, v) and min_ps(hi, t) keep a NaN v.
+    _mm256_storeu_ps(r0 + x, _mm256_min_ps(hi, _mm256_max_ps(lo, v[0])));
+    _mm256_storeu_ps(r1 + x, _mm256_min_ps(hi, _mm256_max_ps(lo, v[1])));
+    _mm256_storeu_ps(r2 + x, _mm256_min_ps(hi, _mm256_max_ps(lo, v[2])));
+  }
+  return x;
+}
+
+// The demodulation of n interleaved floats (RGB albedo): a = finite(v) ? max(v, lo) : 1,
+// il = co / a, 8 at a time; returns the first not done.
+__attribute__((target("avx2"))) std::size_t demodulate_avx2(const float* ad, const float* co, float lo, std::size_t n,
+                                                            float* al, float* il) {
+  const __m256 lo8 = _mm256_set1_ps(lo), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
+  std::size_t j = 0;
+  for (; j + 8 <= n; j += 8) {
+    const __m256 v = _mm256_loadu_ps(ad + j);
+    const __m256 fin = _mm256_cmp_ps(_mm256_sub_ps(v, v), zero, _CMP_EQ_OQ);
+    const __m256 a = _mm256_blendv_ps(one, _mm256_max_ps(lo8, v), fin);  // std::max(v, lo) = max_ps(lo, v)
+    _mm256_storeu_ps(al + j, a);
+    _mm256_storeu_ps(il + j, _mm256_div_ps(_mm256_loadu_ps(co + j), a));
+  }
+  return j;
+}
+#endif
 }  // namespace
 
 void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
@@ -162,7 +213,11 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       const float* co = colour.data();
       const float* ad = ai.data();
       if (ach == 3) {  // the usual RGB albedo: one flat, vectorisable loop
-        for (std::size_t j = b * 3; j < e * 3; ++j) {
+        std::size_t j0 = b * 3;
+#ifdef MCR_BMFR_AVX2
+        if (has_avx2()) j0 += demodulate_avx2(ad + j0, co + j0, lo, (e - b) * 3, al + j0, il + j0);
+#endif
+        for (std::size_t j = j0; j < e * 3; ++j) {
           const float v = ad[j];
           const float a = (v - v == 0.0f) ? std::max(v, lo) : 1.0f;  // v - v: NaN for NaN/Inf
           al[j] = a;
@@ -219,16 +274,20 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     float* r1 = r0 + n;
     float* r2 = r1 + n;
     constexpr float M = std::numeric_limits<float>::max();
+    int x0 = 0;
+#ifdef MCR_BMFR_AVX2
+    if (has_avx2()) x0 = remodulate_row_avx2(s, a, w, r0, r1, r2);
+#endif
     // Infinities become +-max, NaN stays (std::min/max keep their first argument).
     if (a)
-      for (int x = 0; x < w; ++x) {
+      for (int x = x0; x < w; ++x) {
         const std::size_t i = std::size_t(x) * 3;
         r0[x] = std::min(std::max(s[i] * a[i], -M), M);
         r1[x] = std::min(std::max(s[i + 1] * a[i + 1], -M), M);
         r2[x] = std::min(std::max(s[i + 2] * a[i + 2], -M), M);
       }
     else
-      for (int x = 0; x < w; ++x) {
+      for (int x = x0; x < w; ++x) {
         const std::size_t i = std::size_t(x) * 3;
         r0[x] = std::min(std::max(s[i], -M), M);
         r1[x] = std::min(std::max(s[i + 1], -M), M);

@@ -10,11 +10,11 @@
 #include "linalg/householder_qr.h"
 #include "util/parallel.h"
 
-#include <tbb/enumerable_thread_specific.h>
 
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#include "util/avx2_shuffles.h"
 
 namespace mcr {
 
@@ -161,6 +161,53 @@ void scale_masked(const float* src, const float* mask, int np, float lo, float s
 #define MCR_FIT_CLONES
 #endif
 
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_FIT_GATHER_AVX2 1
+bool has_avx2() {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+  }();
+  return yes;
+}
+
+// The default feature set's gather (normal and position, 3 channels each, no extras) of
+// block row y for pixels [0, n8), n8 a multiple of 8, p the first pixel's index in the
+// block: the loop in fit_block 8 pixels at a time (the same values; deinterleaved by
+// shuffles). Returns the new count of fitted rows.
+__attribute__((target("avx2"))) int gather_row_avx2(const float* nrow, const float* prow, const float* irow,
+                                                     const float* vrow, int n8, int p, std::size_t snp, float* raw,
+                                                     float* fin, float* zp, int* rows, int W) {
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  for (int x = 0; x < n8; x += 8, p += 8) {
+    __m256 v[6], z[3];
+    load_rgb8(nrow + std::size_t(x) * 3, v[0], v[1], v[2]);
+    load_rgb8(prow + std::size_t(x) * 3, v[3], v[4], v[5]);
+    load_rgb8(irow + std::size_t(x) * 3, z[0], z[1], z[2]);
+    __m256 f = zero;  // 0 where all six are finite, NaN otherwise
+    for (int c = 0; c < 6; ++c) {
+      _mm256_storeu_ps(raw + std::size_t(c) * snp + std::size_t(p), v[c]);
+      f = _mm256_add_ps(f, _mm256_sub_ps(v[c], v[c]));
+    }
+    const __m256 ok = _mm256_cmp_ps(f, zero, _CMP_EQ_OQ);
+    _mm256_storeu_ps(fin + p, _mm256_and_ps(ok, one));
+    for (int c = 0; c < 3; ++c) _mm256_storeu_ps(zp + std::size_t(c) * snp + std::size_t(p), z[c]);
+    const int fit = _mm256_movemask_ps(_mm256_and_ps(ok, _mm256_cmp_ps(_mm256_loadu_ps(vrow + x), zero, _CMP_GT_OQ)));
+    for (int l = 0; l < 8; ++l) {
+      rows[W] = p + l;
+      W += (fit >> l) & 1;
+    }
+  }
+  return W;
+}
+#endif
+
+// 4 doubles / floats / int32 (GCC vector extensions: AVX in the AVX2 clone, SSE2 pairs
+// in the default one); loaded and stored unaligned.
+typedef double v4d __attribute__((vector_size(32), aligned(8)));
+typedef float v4f __attribute__((vector_size(16), aligned(4)));
+typedef std::int32_t v4i __attribute__((vector_size(16)));
+
 struct FitScratch {
   std::vector<float> raw;    // R columns x np, planar
   std::vector<float> feat;   // M columns x np, planar, scaled, noise-free
@@ -223,7 +270,15 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     const float* prow = pos.data() + rb * std::size_t(pch);
     const float* irow = illum.data() + rb * 3;
     const float* vrow = valid + rb;
-    for (int x = 0; x < bw; ++x, ++p) {
+    int x = 0;
+#ifdef MCR_FIT_GATHER_AVX2
+    if (!alb && !dep && pch == 3 && nch == 3 && has_avx2()) {
+      x = bw / 8 * 8;
+      W = gather_row_avx2(nrow, prow, irow, vrow, x, p, snp, raw, fin, zp, rows, W);
+      p += x;
+    }
+#endif
+    for (; x < bw; ++x, ++p) {
       const float* n = nrow + std::size_t(x) * std::size_t(nch);
       const float* q = prow + std::size_t(x) * std::size_t(pch);
       const float v[6] = {n[0], n[1], n[2], q[0], q[1], q[2]};
@@ -310,22 +365,29 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     xorshift_stream(xs, S.noise.data(), need);
     nz = S.noise.data();
   }
+  // Step r >> 1 gives row r its low half (r even) or high half (r odd): on a
+  // little-endian machine that is 32-bit word r of the stream, a loop the compiler
+  // vectorises (int32 -> double conversions).
+  typedef std::int32_t noise_word __attribute__((__may_alias__));
+  static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "noise words assume little endian");
+  const int even = W & ~1;
   for (int m = 1; m < M; ++m) {
     double* col = mat + std::size_t(m) * sW;
     const float* fm = feat + std::size_t(m) * snp;
-    if (dense)
+    const noise_word* q = nz ? reinterpret_cast<const noise_word*>(nz + std::size_t(m - 1) * hs) : nullptr;
+    if (dense && q)
+      for (int r = 0; r < even; ++r) col[r] = double(fm[r]) + e31 * double(q[r]);
+    else if (dense)
       for (int r = 0; r < W; ++r) col[r] = double(fm[r]);
     else
       for (int r = 0; r < W; ++r) col[r] = double(fm[rows[r]]);
-    if (nz) {
-      const std::uint64_t* q = nz + std::size_t(m - 1) * hs;
-      int r = 0;
-      for (; r + 2 <= W; r += 2) {
-        const std::uint64_t v = q[r >> 1];
-        col[r] += e31 * double(std::int32_t(std::uint32_t(v)));
-        col[r + 1] += e31 * double(std::int32_t(std::uint32_t(v >> 32)));
+    if (q) {
+      if (!dense)
+        for (int r = 0; r < even; ++r) col[r] += e31 * double(q[r]);
+      if (even < W) {  // odd last row: the high half of its step
+        if (dense) col[even] = double(fm[even]);
+        col[even] += e31 * double(q[even + 1]);
       }
-      if (r < W) col[r] += e31 * double(std::int32_t(std::uint32_t(q[r >> 1] >> 32)));
     }
   }
   double zmin[3], zmax[3];
@@ -333,11 +395,37 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     double* col = mat + std::size_t(M + c) * sW;
     const float* zc = zp + std::size_t(c) * snp;
     float zm = INFINITY, zx = -INFINITY;
-    for (int r = 0; r < W; ++r) {
-      const float z = zc[rows[r]];
-      col[r] = double(z);
-      zm = std::min(zm, z);
-      zx = std::max(zx, z);
+    if (dense) {
+      // 8 running minima and maxima (min and max do not depend on the order; NaN is
+      // skipped either way), so the loop vectorises.
+      float m8[8], x8[8];
+      std::fill(m8, m8 + 8, INFINITY);
+      std::fill(x8, x8 + 8, -INFINITY);
+      int r = 0;
+      for (; r + 8 <= W; r += 8)
+        for (int l = 0; l < 8; ++l) {
+          const float z = zc[r + l];
+          col[r + l] = double(z);
+          m8[l] = z < m8[l] ? z : m8[l];
+          x8[l] = x8[l] < z ? z : x8[l];
+        }
+      for (int l = 0; l < 8; ++l) {
+        zm = std::min(zm, m8[l]);
+        zx = std::max(zx, x8[l]);
+      }
+      for (; r < W; ++r) {
+        const float z = zc[r];
+        col[r] = double(z);
+        zm = std::min(zm, z);
+        zx = std::max(zx, z);
+      }
+    } else {
+      for (int r = 0; r < W; ++r) {
+        const float z = zc[rows[r]];
+        col[r] = double(z);
+        zm = std::min(zm, z);
+        zx = std::max(zx, z);
+      }
     }
     zmin[c] = double(zm);
     zmax[c] = double(zx);
@@ -345,24 +433,61 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
   S.qr.factorize(mat, W, M, 3);
   double alpha[3][32];
   for (int c = 0; c < 3; ++c) S.qr.solve(c, alpha[c]);
-  // Synthesis with the noise-free features (planar, vectorised over the pixels).
+  // Synthesis with the noise-free features, the three channels in one sweep over each
+  // 4-pixel chunk (sums in registers; per channel the same terms in the same order as
+  // a channel-by-channel loop, a zero coefficient skipped).
   double* acc = S.acc.data();
+  bool use[3][32];
+  for (int c = 0; c < 3; ++c)
+    for (int m = 1; m < M; ++m) use[c][m] = alpha[c][m] != 0.0;
+  int i4 = 0;
+  for (; i4 + 4 <= np; i4 += 4) {
+    v4d s0 = v4d{} + alpha[0][0], s1 = v4d{} + alpha[1][0], s2 = v4d{} + alpha[2][0];
+    for (int m = 1; m < M; ++m) {
+      const v4d f = __builtin_convertvector(*reinterpret_cast<const v4f*>(feat + std::size_t(m) * snp + std::size_t(i4)), v4d);
+      if (use[0][m]) s0 += alpha[0][m] * f;
+      if (use[1][m]) s1 += alpha[1][m] * f;
+      if (use[2][m]) s2 += alpha[2][m] * f;
+    }
+    *reinterpret_cast<v4d*>(acc + std::size_t(i4)) = s0;
+    *reinterpret_cast<v4d*>(acc + snp + std::size_t(i4)) = s1;
+    *reinterpret_cast<v4d*>(acc + 2 * snp + std::size_t(i4)) = s2;
+  }
   for (int c = 0; c < 3; ++c) {
     double* ac = acc + std::size_t(c) * snp;
-    const double a0 = alpha[c][0];
-    for (int i = 0; i < np; ++i) ac[i] = a0;
+    for (int i = i4; i < np; ++i) ac[i] = alpha[c][0];
     for (int m = 1; m < M; ++m) {
-      const double am = alpha[c][m];
-      if (am == 0.0) continue;
+      if (!use[c][m]) continue;
       const float* fm = feat + std::size_t(m) * snp;
-      for (int i = 0; i < np; ++i) ac[i] += am * double(fm[i]);
+      for (int i = i4; i < np; ++i) ac[i] += alpha[c][m] * double(fm[i]);
     }
   }
   const double zlo[3] = {std::min(0.0, zmin[0]), std::min(0.0, zmin[1]), std::min(0.0, zmin[2])};
   const double zhi[3] = {std::max(0.0, zmax[0]), std::max(0.0, zmax[1]), std::max(0.0, zmax[2])};
   for (int y = y0, i = 0; y < y1; ++y) {
     float* o = fitted.data() + (std::size_t(y) * std::size_t(w) + std::size_t(x0)) * 3;
-    for (int x = 0; x < bw; ++x, ++i)
+    int x = 0;
+    // 4 pixels at a time: the scalar loop below as vector selects (the same values).
+    for (; x + 4 <= bw; x += 4, i += 4) {
+      v4f out[3];
+      for (int c = 0; c < 3; ++c) {
+        const v4d a = *reinterpret_cast<const v4d*>(acc + std::size_t(c) * snp + std::size_t(i));
+        v4d v = a < zlo[c] ? v4d{} + zlo[c] : a;  // std::max(a, zlo)
+        if (clamp_max) v = zhi[c] < v ? v4d{} + zhi[c] : v;  // std::min(v, zhi)
+        v4d cl = v < -kFloatMax ? v4d{} - kFloatMax : v;  // std::clamp(v, -max, max)
+        cl = kFloatMax < cl ? v4d{} + kFloatMax : cl;
+        const v4f f = __builtin_convertvector(cl, v4f);
+        const v4f nan = v4f{} + std::numeric_limits<float>::quiet_NaN();
+        out[c] = __builtin_convertvector((v - v) == 0.0, v4i) ? f : nan;  // finite: v - v == 0
+      }
+      float* op = o + std::size_t(x) * 3;
+      for (int l = 0; l < 4; ++l) {
+        op[3 * l] = out[0][l];
+        op[3 * l + 1] = out[1][l];
+        op[3 * l + 2] = out[2][l];
+      }
+    }
+    for (; x < bw; ++x, ++i)
       for (int c = 0; c < 3; ++c) {
         // Radiance is not negative: no fit below min(0, the block's smallest input).
         // Nor above the block's largest input: an ill-conditioned fit extrapolating at
@@ -409,19 +534,22 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   FitJob job{w, h, B, ox, oy, nbx, R, M, pch, nch, lay, eps, seed, frame_index_, clamp_max, &pos, &nrm, alb, dep, &illum,
              valid.data(), &fitted};
   tbb::task_arena arena(arena_threads(nthreads));
-  tbb::enumerable_thread_specific<FitScratch> scratch;
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, nblocks, 1), [&](const tbb::blocked_range<int>& range) {
-      FitScratch& S = scratch.local();
-      if (S.fin.size() < cap) {
-        S.raw.resize(cap * std::size_t(R));
-        S.feat.resize(cap * std::size_t(M));
-        S.fin.resize(cap);
-        S.z.resize(cap * 3);
-        S.rows.resize(cap);
-        S.mat.resize(cap * std::size_t(M + 3));
-        S.acc.resize(cap * 3);
-      }
+      // Per thread, kept from frame to frame (a fresh scratch per frame was ~200 KB of
+      // new pages per thread and frame).
+      thread_local FitScratch S;
+      // Grown only (block size and feature set may change between calls).
+      auto grow = [](auto& v, std::size_t k) {
+        if (v.size() < k) v.resize(k);
+      };
+      grow(S.raw, cap * std::size_t(R));
+      grow(S.feat, cap * std::size_t(M));
+      grow(S.fin, cap);
+      grow(S.z, cap * 3);
+      grow(S.rows, cap);
+      grow(S.mat, cap * std::size_t(M + 3));
+      grow(S.acc, cap * 3);
       for (int b = range.begin(); b != range.end(); ++b) {
         fit_block(job, S, b);
       }

@@ -15,6 +15,8 @@
 #include <limits>
 
 #include "filters/bmfr.h"
+#include "filters/bmfr_taa_avx2.h"
+#include "filters/bmfr_taa_cr.h"
 #include "util/parallel.h"
 
 #if defined(__SSE2__)
@@ -26,77 +28,6 @@ namespace mcr {
 namespace {
 
 constexpr float kMax = std::numeric_limits<float>::max();
-
-inline void cr_weights(float t, float* wt) {
-  const float t2 = t * t, t3 = t2 * t;
-  wt[0] = 0.5f * (-t3 + 2 * t2 - t);
-  wt[1] = 0.5f * (3 * t3 - 5 * t2 + 2);
-  wt[2] = 0.5f * (-3 * t3 + 4 * t2 + t);
-  wt[3] = 0.5f * (t3 - t2);
-}
-
-// Catmull-Rom sample of the planar RGB history at (x, y) (pixel centres at integers),
-// taps clamped to the border. False when (x, y) lies outside the image.
-inline bool catmull_rom_planar(const float* hist, int w, int h, std::size_t n, float x, float y, float* out) {
-  if (!(x >= -0.5f && y >= -0.5f && x <= float(w) - 0.5f && y <= float(h) - 0.5f)) return false;
-  const int ix = floor_int(x), iy = floor_int(y);
-  float wx[4], wy[4];
-  cr_weights(x - float(ix), wx);
-  cr_weights(y - float(iy), wy);
-  const int bx = ix - 1, by = iy - 1;
-  if (bx >= 0 && by >= 0 && bx + 3 < w && by + 3 < h) {  // interior: no clamping
-    const float* base = hist + std::size_t(by) * std::size_t(w) + std::size_t(bx);
-#if defined(__SSE2__)
-    // Per channel: the 4 tap rows weighted by wy (lanes = tap columns), then the dot
-    // with wx; the three dots are finished together by a 4x4 transpose.
-    const __m128 wy0 = _mm_set1_ps(wy[0]), wy1 = _mm_set1_ps(wy[1]), wy2 = _mm_set1_ps(wy[2]), wy3 = _mm_set1_ps(wy[3]);
-    const __m128 wxv = _mm_loadu_ps(wx);
-    __m128 acc[3];
-    for (int c = 0; c < 3; ++c) {
-      const float* p = base + std::size_t(c) * n;
-      __m128 a = _mm_mul_ps(wy0, _mm_loadu_ps(p));
-      a = _mm_add_ps(a, _mm_mul_ps(wy1, _mm_loadu_ps(p + w)));
-      a = _mm_add_ps(a, _mm_mul_ps(wy2, _mm_loadu_ps(p + 2 * std::size_t(w))));
-      a = _mm_add_ps(a, _mm_mul_ps(wy3, _mm_loadu_ps(p + 3 * std::size_t(w))));
-      acc[c] = _mm_mul_ps(a, wxv);
-    }
-    __m128 r0 = acc[0], r1 = acc[1], r2 = acc[2], r3 = _mm_setzero_ps();
-    _MM_TRANSPOSE4_PS(r0, r1, r2, r3);
-    const __m128 s = _mm_add_ps(_mm_add_ps(r0, r1), _mm_add_ps(r2, r3));
-    float o4[4];
-    _mm_storeu_ps(o4, s);
-    out[0] = o4[0];
-    out[1] = o4[1];
-    out[2] = o4[2];
-#else
-    for (int c = 0; c < 3; ++c) {
-      const float* p = base + std::size_t(c) * n;
-      float col[4] = {0, 0, 0, 0};
-      for (int j = 0; j < 4; ++j)
-        for (int i = 0; i < 4; ++i) col[i] += wy[j] * p[std::size_t(j) * std::size_t(w) + std::size_t(i)];
-      out[c] = (col[0] * wx[0] + col[1] * wx[1]) + (col[2] * wx[2] + col[3] * wx[3]);
-    }
-#endif
-    return true;
-  }
-  int xs[4], ys[4];
-  for (int i = 0; i < 4; ++i) {
-    xs[i] = std::clamp(bx + i, 0, w - 1);
-    ys[i] = std::clamp(by + i, 0, h - 1);
-  }
-  for (int c = 0; c < 3; ++c) {
-    const float* p = hist + std::size_t(c) * n;
-    float acc = 0;
-    for (int j = 0; j < 4; ++j) {
-      const float* row = p + std::size_t(ys[j]) * std::size_t(w);
-      float r = 0;
-      for (int i = 0; i < 4; ++i) r += wx[i] * row[xs[i]];
-      acc += wy[j] * r;
-    }
-    out[c] = acc;
-  }
-  return true;
-}
 
 // Bilinear sample of the planar history over the taps inside the frame, normalised by
 // their weights (Reprojection::sample on a planar image).
@@ -185,6 +116,7 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
   const float* H = taa_hist_.data();
   float* N = taa_next_.data();
   const int ox0 = roi.x0, ox1 = roi.x1;
+  const bool avx2 = detail::taa_avx2_available();
 
   parallel_rows(0, h, nthreads, [&](int y) {
     thread_local TaaRow T;
@@ -206,6 +138,14 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
         mx = std::max(v0, std::max(v1, v2));
       };
       int x = 0;
+      if (avx2) {
+        float* const s3[3] = {cs0, cs1, cs2};
+        float* const q3[3] = {cq0, cq1, cq2};
+        float* const n3[3] = {mn0, mn1, mn2};
+        float* const x3[3] = {mx0, mx1, mx2};
+        float* const u3[3] = {cu0, cu1, cu2};
+        x = detail::taa_stats_avx2(x, w, ycocg, R, G, Bc, r0, r1, r2, s3, q3, n3, x3, u3);
+      }
 #if defined(__SSE2__)
       {
         // std::min(v0, std::min(v1, v2)) = _mm_min_ps(_mm_min_ps(v2, v1), v0), same for max.
@@ -286,7 +226,7 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
       const float* cur = T.cur[k];
       float* blo = T.lo[k];
       float* bhi = T.hi[k];
-      int x = 0;
+      int x = avx2 ? detail::taa_box_avx2(0, w, ycocg, gamma, cs, cq, cmn, cmx, cur, blo, bhi) : 0;
 #if defined(__SSE2__)
       const __m128 ninth = _mm_set1_ps(1.0f / 9.0f), g4 = _mm_set1_ps(gamma), zero = _mm_setzero_ps();
       for (; x + 4 <= w; x += 4) {
@@ -329,18 +269,23 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
       float* h1 = T.hv[1];
       float* h2 = T.hv[2];
       float* okr = T.ok;
-      for (int x = 0; x < w; ++x) {
-        const std::size_t i = rb + std::size_t(x);
-        float hv[3] = {0, 0, 0};
-        bool ok;
-        if (cubic)
-          ok = rep.inside[i] && catmull_rom_planar(H, w, h, n, rep.prev_x[i], rep.prev_y[i], hv);
-        else
-          ok = bilinear_planar(rep, H, n, i, hv);
-        h0[x] = hv[0];
-        h1[x] = hv[1];
-        h2[x] = hv[2];
-        okr[x] = ok ? 1.0f : 0.0f;
+      if (cubic && avx2) {
+        detail::taa_lookup_cr_avx2(w, h, n, H, rep.prev_x.data() + rb, rep.prev_y.data() + rb, rep.inside.data() + rb, h0,
+                                   h1, h2, okr);
+      } else {
+        for (int x = 0; x < w; ++x) {
+          const std::size_t i = rb + std::size_t(x);
+          float hv[3] = {0, 0, 0};
+          bool ok;
+          if (cubic)
+            ok = rep.inside[i] && catmull_rom_planar(H, w, h, n, rep.prev_x[i], rep.prev_y[i], hv);
+          else
+            ok = bilinear_planar(rep, H, n, i, hv);
+          h0[x] = hv[0];
+          h1[x] = hv[1];
+          h2[x] = hv[2];
+          okr[x] = ok ? 1.0f : 0.0f;
+        }
       }
     }
     // 4. Clip, blend, guard (branch-free: vectorised).
@@ -359,6 +304,12 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
       float* ng = nr + n;
       float* nb = ng + n;
       int x = 0;
+      if (avx2) {
+        const float* const hv3[3] = {h0, h1, h2};
+        const float* const lo3[3] = {lo0, lo1, lo2};
+        const float* const hi3[3] = {hi0, hi1, hi2};
+        x = detail::taa_clip_avx2(x, w, ycocg, a, hv3, okr, lo3, hi3, cr, cg, cb, nr, ng, nb);
+      }
 #if defined(__SSE2__)
       {
         const __m128 q4 = _mm_set1_ps(0.25f), h2 = _mm_set1_ps(0.5f), mq4 = _mm_set1_ps(-0.25f);

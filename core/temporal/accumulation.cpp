@@ -2,9 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
 
 #include "util/error.h"
 #include "util/parallel.h"
+#include "util/avx2_shuffles.h"
 
 namespace mcr {
 
@@ -29,14 +35,15 @@ namespace {
 // Row y of the blend for 3 channels (every BMFR buffer): the generic loop below with the
 // channel count fixed, so the history and the blend stay in registers. Same operations in
 // the same order.
+// Pixels [xb, w) of the row.
 void row3(int y, const Reprojection& r, const float* crow_all, const float* hist, const float* hcount, float af,
-          int w, float* orow, float* ncount) {
+          int w, float* orow, float* ncount, int xb = 0) {
   const float* crow = crow_all + std::size_t(y) * std::size_t(w) * 3;
   const std::uint8_t* taps = r.taps.data() + std::size_t(y) * std::size_t(w);
   const float* pxs = r.prev_x.data() + std::size_t(y) * std::size_t(w);
   const float* pys = r.prev_y.data() + std::size_t(y) * std::size_t(w);
   const std::size_t sw = std::size_t(w);
-  for (int x = 0; x < w; ++x) {
+  for (int x = xb; x < w; ++x) {
     const float* c = crow + std::size_t(x) * 3;
     float* o = orow + std::size_t(x) * 3;
     const float c0 = c[0], c1 = c[1], c2 = c[2];
@@ -95,11 +102,141 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
   }
 }
 
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_ACC_AVX2 1
+// row3 for 8 pixels at a time (AVX2 without FMA: every lane does the float operations of
+// row3 in the same order, so the results are the same bit for bit). The taps are
+// gathered; a tap that row3 skips leaves the sums untouched (blend, not + 0).
+__attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, const float* crow_all, const float* hist,
+                                               const float* hcount, float af, int w, float* orow, float* ncount) {
+  const std::size_t rb = std::size_t(y) * std::size_t(w);
+  const float* crow = crow_all + rb * 3;
+  const std::uint8_t* taps = r.taps.data() + rb;
+  const float* pxs = r.prev_x.data() + rb;
+  const float* pys = r.prev_y.data() + rb;
+  const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f), half = _mm256_set1_ps(0.5f),
+               tiny = _mm256_set1_ps(1e-6f), afv = _mm256_set1_ps(af), cmax = _mm256_set1_ps(65535.0f);
+  const __m256i iw = _mm256_set1_epi32(w), three = _mm256_set1_epi32(3);
+  const __m256i last8 = _mm256_set1_epi32(int(std::size_t(w) * std::size_t(r.height)) - 3);
+  const std::size_t last = std::size_t(w) * std::size_t(r.height) - 1;
+  const __m256i off[4] = {_mm256_setzero_si256(), _mm256_set1_epi32(1), iw, _mm256_set1_epi32(w + 1)};
+  int x = 0;
+  for (; x + 8 <= w; x += 8) {
+    const float* c = crow + std::size_t(x) * 3;
+    __m256 c0, c1, c2;
+    load_rgb8(c, c0, c1, c2);
+    const __m256 finite =
+        _mm256_cmp_ps(_mm256_add_ps(_mm256_add_ps(_mm256_sub_ps(c0, c0), _mm256_sub_ps(c1, c1)), _mm256_sub_ps(c2, c2)),
+                      zero, _CMP_EQ_OQ);
+    __m256 h0 = zero, h1 = zero, h2 = zero, n = zero, have = zero;
+    std::uint64_t m8 = 0;
+    if (hist) std::memcpy(&m8, taps + x, 8);
+    if (m8) {
+      // The history rows y and y + 1 some pixels ahead (taps follow the pixel for small
+      // motion): their first touch is otherwise a cache miss inside a gather.
+      const std::size_t ahead = std::min(rb + std::size_t(x) + 64, last);
+      const std::size_t below = std::min(ahead + std::size_t(w), last);
+      _mm_prefetch(reinterpret_cast<const char*>(hcount + ahead), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hcount + below), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + ahead * 3), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + ahead * 3 + 16), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + below * 3), _MM_HINT_T0);
+      _mm_prefetch(reinterpret_cast<const char*>(hist + below * 3 + 16), _MM_HINT_T0);
+      const __m256i mask = _mm256_cvtepu8_epi32(_mm_cvtsi64_si128(static_cast<long long>(m8)));
+      const __m256 px = _mm256_loadu_ps(pxs + x), py = _mm256_loadu_ps(pys + x);
+      // floor_int: truncate, minus one where that rounded up.
+      __m256i x0 = _mm256_cvttps_epi32(px), y0 = _mm256_cvttps_epi32(py);
+      x0 = _mm256_add_epi32(x0, _mm256_castps_si256(_mm256_cmp_ps(_mm256_cvtepi32_ps(x0), px, _CMP_GT_OQ)));
+      y0 = _mm256_add_epi32(y0, _mm256_castps_si256(_mm256_cmp_ps(_mm256_cvtepi32_ps(y0), py, _CMP_GT_OQ)));
+      const __m256 fx = _mm256_sub_ps(px, _mm256_cvtepi32_ps(x0)), fy = _mm256_sub_ps(py, _mm256_cvtepi32_ps(y0));
+      const __m256 gx = _mm256_sub_ps(one, fx), gy = _mm256_sub_ps(one, fy);
+      const __m256 wt[4] = {_mm256_mul_ps(gx, gy), _mm256_mul_ps(fx, gy), _mm256_mul_ps(gx, fy), _mm256_mul_ps(fx, fy)};
+      const __m256i t0 = _mm256_add_epi32(_mm256_mullo_epi32(y0, iw), x0);
+      __m256 sum = zero, cnt = zero;
+      // Taps in pairs (k, k + 1) on one history row: per lane one 8-float load covers
+      // both taps' RGB (a transpose makes them planes); the counts are gathered.
+      for (int k = 0; k < 4; k += 2) {
+        __m256 on[2];
+        for (int j = 0; j < 2; ++j) {
+          const __m256i bit = _mm256_set1_epi32(1 << (k + j));
+          on[j] = _mm256_and_ps(_mm256_castsi256_ps(_mm256_cmpeq_epi32(_mm256_and_si256(mask, bit), bit)),
+                                _mm256_cmp_ps(wt[k + j], zero, _CMP_GT_OQ));
+        }
+        const __m256 any = _mm256_or_ps(on[0], on[1]);
+        if (_mm256_testz_ps(any, any)) continue;
+        const __m256i t = _mm256_add_epi32(t0, off[k]);
+        const __m256 tc[2] = {_mm256_mask_i32gather_ps(zero, hcount, t, on[0], 4),
+                              _mm256_mask_i32gather_ps(zero, hcount, _mm256_add_epi32(t, off[1]), on[1], 4)};
+        const __m256 use[2] = {_mm256_and_ps(on[0], _mm256_cmp_ps(tc[0], zero, _CMP_GT_OQ)),
+                               _mm256_and_ps(on[1], _mm256_cmp_ps(tc[1], zero, _CMP_GT_OQ))};
+        __m256 v[8];
+        const __m256i ti = _mm256_and_si256(t, _mm256_castps_si256(any));  // lanes off read pixel 0
+        // 8 floats from pixel ti stay inside the image up to ti = n - 3; past that (the
+        // last two pixels) the taps are gathered.
+        if (_mm256_movemask_ps(_mm256_castsi256_ps(_mm256_cmpgt_epi32(ti, last8))) == 0) {
+          alignas(32) int idx[8];
+          _mm256_store_si256(reinterpret_cast<__m256i*>(idx), ti);
+          for (int l = 0; l < 8; ++l) v[l] = _mm256_loadu_ps(hist + std::size_t(idx[l]) * 3);
+          transpose8(v);
+        } else {
+          for (int j = 0; j < 2; ++j) {
+            const __m256i t3 = _mm256_mullo_epi32(_mm256_add_epi32(t, off[j]), three);
+            for (int c = 0; c < 3; ++c) v[3 * j + c] = _mm256_mask_i32gather_ps(zero, hist + c, t3, use[j], 4);
+          }
+        }
+        for (int j = 0; j < 2; ++j) {
+          const __m256 wk = wt[k + j], u = use[j];
+          sum = _mm256_blendv_ps(sum, _mm256_add_ps(sum, wk), u);
+          cnt = _mm256_blendv_ps(cnt, _mm256_add_ps(cnt, _mm256_mul_ps(wk, tc[j])), u);
+          h0 = _mm256_blendv_ps(h0, _mm256_add_ps(h0, _mm256_mul_ps(wk, v[3 * j])), u);
+          h1 = _mm256_blendv_ps(h1, _mm256_add_ps(h1, _mm256_mul_ps(wk, v[3 * j + 1])), u);
+          h2 = _mm256_blendv_ps(h2, _mm256_add_ps(h2, _mm256_mul_ps(wk, v[3 * j + 2])), u);
+        }
+      }
+      have = _mm256_cmp_ps(sum, tiny, _CMP_GT_OQ);
+      const __m256 inv = _mm256_div_ps(one, sum);
+      h0 = _mm256_and_ps(have, _mm256_mul_ps(h0, inv));
+      h1 = _mm256_and_ps(have, _mm256_mul_ps(h1, inv));
+      h2 = _mm256_and_ps(have, _mm256_mul_ps(h2, inv));
+      // std::max(1.0f, float(int(cnt * inv + 0.5f)))
+      const __m256 rc = _mm256_cvtepi32_ps(_mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(cnt, inv), half)));
+      n = _mm256_and_ps(have, _mm256_max_ps(rc, one));
+    }
+    // Finite with history: blend; finite without: the new value (count 1); non-finite:
+    // the history (or 0, count 0).
+    const __m256 wn = _mm256_max_ps(afv, _mm256_div_ps(one, _mm256_add_ps(n, one)));  // std::max(1/(n+1), af)
+    const __m256 blend = _mm256_and_ps(finite, have), fresh = _mm256_andnot_ps(have, finite);
+    const __m256 o0 = _mm256_blendv_ps(_mm256_blendv_ps(h0, c0, fresh), _mm256_add_ps(h0, _mm256_mul_ps(wn, _mm256_sub_ps(c0, h0))), blend);
+    const __m256 o1 = _mm256_blendv_ps(_mm256_blendv_ps(h1, c1, fresh), _mm256_add_ps(h1, _mm256_mul_ps(wn, _mm256_sub_ps(c1, h1))), blend);
+    const __m256 o2 = _mm256_blendv_ps(_mm256_blendv_ps(h2, c2, fresh), _mm256_add_ps(h2, _mm256_mul_ps(wn, _mm256_sub_ps(c2, h2))), blend);
+    const __m256 nc = _mm256_blendv_ps(_mm256_blendv_ps(n, one, fresh), _mm256_min_ps(_mm256_add_ps(n, one), cmax), blend);
+    _mm256_storeu_ps(ncount + x, nc);
+    store_rgb8(orow + std::size_t(x) * 3, o0, o1, o2);
+  }
+  row3(y, r, crow_all, hist, hcount, af, w, orow, ncount, x);
+}
+
+bool has_avx2() {
+  static const bool yes = [] {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+  }();
+  return yes;
+}
+#endif
+
 }  // namespace
 
 void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current, double alpha) {
   const int w = current.width(), h = current.height(), ch = current.channels();
   if (ch == 3) {
+#ifdef MCR_ACC_AVX2
+    if (has_avx2()) {
+      row3_avx2(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha),
+                w, next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
+      return;
+    }
+#endif
     row3(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha), w,
          next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
     return;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 
+#include "temporal/reprojection_avx2.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -14,19 +15,10 @@ namespace {
 }  // namespace
 
 void GeometryHistory::reset() {
-  position_ = Image();
-  normal_ = Image();
-  next_position_ = Image();
-  next_normal_ = Image();
-  info_.clear();
-  next_info_.clear();
+  geo_.clear();
+  next_geo_.clear();
+  geo_w_ = geo_h_ = 0;
 }
-
-namespace {
-void ensure(Image& im, int w, int h, int ch) {
-  if (im.width() != w || im.height() != h || im.channels() != ch) im = Image(w, h, ch);
-}
-}  // namespace
 
 void GeometryHistory::begin(const Image& position, const Image& normal, const Image*& motion, Reprojection& r) {
   (void)normal;
@@ -39,13 +31,11 @@ void GeometryHistory::begin(const Image& position, const Image& normal, const Im
   r.prev_y.resize(n);
   r.taps.resize(n);
   r.inside.resize(n);
-  r.has_history = !position_.empty() && position_.width() == w && position_.height() == h && info_.size() == n;
+  r.has_history = !geo_.empty() && geo_w_ == w && geo_h_ == h && geo_.size() == n * kGeoRecord;
   r.cut = false;
   r.discarded = 0;
   if (motion && (motion->width() != w || motion->height() != h || motion->channels() < 2)) motion = nullptr;
-  ensure(next_position_, w, h, 3);
-  ensure(next_normal_, w, h, 3);
-  next_info_.resize(n);
+  next_geo_.resize(n * kGeoRecord);
 }
 
 std::size_t GeometryHistory::row(int y, const Image& position, const Image& normal, const Image* motion,
@@ -54,41 +44,31 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
   const int pc_ch = position.channels(), nc_ch = normal.channels();
   const float* prow = position.data() + std::size_t(y) * w * pc_ch;
   const float* nrow = normal.data() + std::size_t(y) * w * nc_ch;
-  // Keep this row of the current geometry for the next frame.
-  {
-    float* dp = next_position_.data() + std::size_t(y) * w * 3;
-    float* dn = next_normal_.data() + std::size_t(y) * w * 3;
-    if (pc_ch == 3)
-      std::copy(prow, prow + std::size_t(w) * 3, dp);
-    else
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) dp[x * 3 + c] = prow[std::size_t(x) * pc_ch + c];
-    if (nc_ch == 3)
-      std::copy(nrow, nrow + std::size_t(w) * 3, dn);
-    else
-      for (int x = 0; x < w; ++x)
-        for (int c = 0; c < 3; ++c) dn[x * 3 + c] = nrow[std::size_t(x) * nc_ch + c];
+  float* grow = next_geo_.data() + std::size_t(y) * w * kGeoRecord;
+  // The AVX2 path (same results) takes the bulk of the row, 8 pixels at a time, and
+  // stores those pixels' records itself; the scalar loops do the rest.
+  const bool vec = r.has_history && pc_ch == 3 && nc_ch == 3 && w > 10 && detail::tap_row_avx2_available();
+  const int vx0 = vec ? 1 : 0, vx1 = vec ? 1 + (w - 2) / 8 * 8 : 0;
+  // This row's records for the next frame.
+  for (int x = 0; x < w; ++x) {
+    if (x == vx0 && vx1 > vx0) x = vx1;
+    const float* p = prow + std::size_t(x) * pc_ch;
+    const float* q = nrow + std::size_t(x) * nc_ch;
+    float* g = grow + std::size_t(x) * kGeoRecord;
+    const float fin = (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]) + (q[0] - q[0]) + (q[1] - q[1]) + (q[2] - q[2]);
+    const float l = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
+    g[0] = p[0];
+    g[1] = p[1];
+    g[2] = p[2];
+    g[3] = q[0];
+    g[4] = q[1];
+    g[5] = q[2];
+    g[6] = fin == 0.0f ? l : std::numeric_limits<float>::quiet_NaN();
+    g[7] = 0.0f;
   }
-  // Per pixel of the stored row: the squared normal length when position and normal are
-  // finite, NaN otherwise (read by the tap tests of the next frame, and below).
-  {
-    const float* dp = next_position_.data() + std::size_t(y) * w * 3;
-    const float* dn = next_normal_.data() + std::size_t(y) * w * 3;
-    float* inf = next_info_.data() + std::size_t(y) * w;
-    for (int x = 0; x < w; ++x) {
-      const float* p = dp + std::size_t(x) * 3;
-      const float* q = dn + std::size_t(x) * 3;
-      const float fin = (p[0] - p[0]) + (p[1] - p[1]) + (p[2] - p[2]) + (q[0] - q[0]) + (q[1] - q[1]) + (q[2] - q[2]);
-      const float l = q[0] * q[0] + q[1] * q[1] + q[2] * q[2];
-      inf[x] = fin == 0.0f ? l : std::numeric_limits<float>::quiet_NaN();
-    }
-  }
-  const float* cinfo = next_info_.data() + std::size_t(y) * w;
-  const float* hinfo = info_.data();
   const float* mrow = motion ? motion->data() + std::size_t(y) * w * motion->channels() : nullptr;
   const int mch = motion ? motion->channels() : 0;
-  const float* hp = position_.data();
-  const float* hn = normal_.data();
+  const float* hg = geo_.data();
   // Float arithmetic on differences: the tests compare distances of neighbouring
   // surface points, where float is ample; overflowing magnitudes read as "far".
   const float thr2 = float(params.position_threshold * params.position_threshold);
@@ -102,7 +82,14 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
   };
   const std::size_t rs = std::size_t(w) * std::size_t(pc_ch);
   std::size_t lost = 0;
+  if (vec) {
+    const std::size_t rb = std::size_t(y) * std::size_t(w);
+    const detail::TapRow a{w, h, y, prow, nrow, grow, mrow, mch, hg, thr2, cs, cs2, relative,
+                           r.prev_x.data() + rb, r.prev_y.data() + rb, r.taps.data() + rb, r.inside.data() + rb};
+    lost += detail::tap_row_avx2(a, vx0, vx1);
+  }
   for (int x = 0; x < w; ++x) {
+    if (x == vx0 && vx1 > vx0) x = vx1;
     const std::size_t i = std::size_t(y) * w + x;
     float px = float(x), py = float(y);
     if (mrow) {
@@ -130,7 +117,7 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
     r.inside[i] = in;
     const float* pc = prow + std::size_t(x) * pc_ch;
     const float* nc = nrow + std::size_t(x) * nc_ch;
-    const float ncl = cinfo[x];  // squared normal length; NaN: non-finite position or normal
+    const float ncl = grow[std::size_t(x) * kGeoRecord + 6];  // squared normal length; NaN: non-finite position or normal
     if (!in || ncl != ncl) {
       r.taps[i] = 0;
       ++lost;
@@ -158,11 +145,11 @@ std::size_t GeometryHistory::row(int y, const Image& position, const Image& norm
     std::uint8_t mask = 0;
     for (int k = 0; k < 4; ++k) {
       if (!(in & (1u << k))) continue;
-      const std::size_t ti = std::size_t(y0 + (k >> 1)) * w + std::size_t(x0 + (k & 1)), t = ti * 3;
-      const float npl = hinfo[ti];
+      const std::size_t ti = std::size_t(y0 + (k >> 1)) * w + std::size_t(x0 + (k & 1));
+      const float* pp = hg + ti * kGeoRecord;
+      const float* np = pp + 3;
+      const float npl = pp[6];
       if (npl != npl) continue;  // non-finite history position or normal
-      const float* pp = hp + t;
-      const float* np = hn + t;
       if (!(d2(pc, pp) <= limit)) continue;
       if (ncl < 1e-6f && npl < 1e-6f) {
         // both background / no normal: agree
@@ -190,9 +177,9 @@ bool GeometryHistory::finish(const ReprojectionParams& params, Reprojection& r, 
     std::fill(r.taps.begin(), r.taps.end(), 0);
     std::fill(r.inside.begin(), r.inside.end(), 0);
   }
-  std::swap(position_, next_position_);
-  std::swap(normal_, next_normal_);
-  std::swap(info_, next_info_);
+  std::swap(geo_, next_geo_);
+  geo_w_ = r.width;
+  geo_h_ = r.height;
   return r.cut;
 }
 

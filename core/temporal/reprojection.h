@@ -66,7 +66,7 @@ class GeometryHistory {
   void update(const Image& position, const Image& normal, const Image* motion, const ReprojectionParams& params,
               int nthreads, Reprojection& r);
   void reset();
-  bool empty() const { return position_.empty(); }
+  bool empty() const { return geo_.empty(); }
 
   // The same update split up so that a caller can fuse its own per-row work with it
   // (TemporalAccumulator does the accumulation of row y right after its reprojection):
@@ -80,11 +80,15 @@ class GeometryHistory {
   bool finish(const ReprojectionParams& params, Reprojection& r, std::size_t discarded);
 
  private:
-  Image position_, normal_;   // previous frame (3 channels)
-  Image next_position_, next_normal_;  // current frame, filled by row()
-  // Per pixel: squared normal length when position and normal are finite, else NaN.
-  std::vector<float> info_, next_info_;
+  // Previous frame's geometry, one 32-byte record per pixel: position xyz, normal xyz,
+  // squared normal length when position and normal are finite (else NaN), 0. A tap
+  // test reads one record (one load) instead of three arrays.
+  std::vector<float> geo_, next_geo_;  // next_: the current frame, filled by row()
+  int geo_w_ = 0, geo_h_ = 0;
 };
+
+// Floats per record of GeometryHistory's packed geometry.
+constexpr int kGeoRecord = 8;
 
 // floor() as an int for |v| < 2^31 (reprojected positions are kept within +-1e7): inline
 // code instead of a libm call on the baseline x86-64 target.
