@@ -101,7 +101,7 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
   for (auto& p : next_) pb.prepare(p);
   pb.prepare(next_ok_);
   pb.prepare(valid_);
-  std::vector<float>& valid = valid_;
+  pb.prepare(next_valid_);
   std::vector<float>* cur = cp.c;
   std::vector<float>* cur_ok = &cp.ok;
   std::vector<float>* nxt = next_;
@@ -111,22 +111,26 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
   pass.pb = pb;
   set_colour_weight(pass, guides, params_, frame, colour, nthreads, noise_a_);
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
-  const int bh = box.height();
+  // Neighbours must hold data (colour) and finite features: valid = ok * guides.ok,
+  // here for the first pass, then written by each pass with its result.
+  std::vector<float>* valid = &valid_;
+  std::vector<float>* nxt_valid = &next_valid_;
+  parallel_rows(0, box.height(), nthreads, [&](int y) {
+    const std::size_t a = std::size_t(y) * pb.stride, b = a + pb.stride;
+    for (std::size_t k = a; k < b; ++k) (*valid)[k] = cp.ok[k] * guides.ok[k];
+  });
+  pass.valid_mask = guides.ok.data();
   for (int i = 1; i <= iterations; ++i) {
     const int step = 1 << (i - 1);
     const Roi region = grow_roi(roi, grow[std::size_t(i)], w, h);
-    // Neighbours must hold data (colour) and finite features.
-    parallel_rows(0, bh, nthreads, [&](int y) {
-      const std::size_t a = std::size_t(y) * pb.stride, b = a + pb.stride;
-      for (std::size_t k = a; k < b; ++k) valid[k] = (*cur_ok)[k] * guides.ok[k];
-    });
     for (int c = 0; c < 3; ++c) {
       pass.colour[c] = cur[c].data();
       pass.out[c] = nxt[c].data();
     }
     pass.colour_ok = cur_ok->data();
     pass.out_ok = nxt_ok->data();
-    pass.valid = valid.data();
+    pass.valid = valid->data();
+    pass.out_valid = i < iterations ? nxt_valid->data() : nullptr;
     // sigma_i = colour_sigma decay^(i-1): a_i = a / decay^(i-1), / scale for the scaled colour.
     pass.colour_amul = float(std::min(1e30, std::pow(decay, -double(i - 1)) / double(cp.scale)));
     pass.off.clear();
@@ -138,6 +142,7 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
     cross_filter(pass, region, nthreads);
     std::swap(cur, nxt);
     std::swap(cur_ok, nxt_ok);
+    std::swap(valid, nxt_valid);
   }
   const float* planes[3] = {cur[0].data(), cur[1].data(), cur[2].data()};
   store_colour(planes, pb, cp.scale, roi, out, nthreads);

@@ -25,7 +25,7 @@ class AtrousFilter : public Filter {
   // Scratch planes kept between execute() calls (no page faults frame after frame).
   ColourPlanes cp_;
   Guides guides_;
-  std::vector<float> next_[3], next_ok_, valid_;
+  std::vector<float> next_[3], next_ok_, valid_, next_valid_;
   std::vector<float> noise_a_;  // colour_weight=noise: per-pixel sqrt(k) of the colour weight
 };
 

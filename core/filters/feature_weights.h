@@ -135,6 +135,8 @@ struct CrossPass {
   std::vector<float> h;              // 1D tap weights; the tap weight is h[i] * h[j]
   float* out[3] = {nullptr, nullptr, nullptr};
   float* out_ok = nullptr;           // optional: 1 where the result holds data
+  float* out_valid = nullptr;        // optional: out_ok * valid_mask, the next pass' valid
+  const float* valid_mask = nullptr; // (written with the result: no extra sweep per pass)
 
   // Unit-weight taps at every offset in [-rmax, rmax] (the dense kernels of
   // gaussian and bilateral; the spatial weight comes from s).
@@ -151,7 +153,10 @@ struct CrossPass {
 // taps inside the image (clipped and renormalised at the borders). A pixel whose
 // taps all have weight 0 gets its own colour when colour_ok, else 0 (out_ok = 0).
 // Deterministic: results do not depend on nthreads or on the region's placement
-// (the instruction set chosen at run time may change the last bits: FMA).
+// (the instruction set chosen at run time may change the last bits: FMA). With no
+// per-pixel colour a, k, s or window and at most 5 x 5 taps (atrous), each pair's
+// exp(-e) is computed once and shared by both pixels (e is symmetric bit for bit):
+// the same result, with half the exponentials.
 void cross_filter(const CrossPass& pass, const Roi& region, int nthreads);
 
 // The instruction set cross_filter() runs on: "avx512" (16 lanes), "avx2" (8 lanes,
