@@ -10,6 +10,7 @@
 #include "util/avx2_shuffles.h"
 #include "util/error.h"
 #include "util/parallel.h"
+#include "util/cpu_features.h"
 
 namespace mcr {
 
@@ -129,13 +130,6 @@ void ensure_image(Image& im, int w, int h, int ch) {
 // AVX2 build does 8 pixels at a time (the same operations), the caller the rest.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define MCR_BMFR_AVX2 1
-bool has_avx2() {
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-  }();
-  return yes;
-}
 
 __attribute__((target("avx2"))) int remodulate_row_avx2(const float* s, const float* a, int w, float* r0, float* r1,
                                                         float* r2) {
@@ -215,7 +209,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       if (ach == 3) {  // the usual RGB albedo: one flat, vectorisable loop
         std::size_t j0 = b * 3;
 #ifdef MCR_BMFR_AVX2
-        if (has_avx2()) j0 += demodulate_avx2(ad + j0, co + j0, lo, (e - b) * 3, al + j0, il + j0);
+        if (cpu_has_avx2()) j0 += demodulate_avx2(ad + j0, co + j0, lo, (e - b) * 3, al + j0, il + j0);
 #endif
         for (std::size_t j = j0; j < e * 3; ++j) {
           const float v = ad[j];
@@ -276,7 +270,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     constexpr float M = std::numeric_limits<float>::max();
     int x0 = 0;
 #ifdef MCR_BMFR_AVX2
-    if (has_avx2()) x0 = remodulate_row_avx2(s, a, w, r0, r1, r2);
+    if (cpu_has_avx2()) x0 = remodulate_row_avx2(s, a, w, r0, r1, r2);
 #endif
     // Infinities become +-max, NaN stays (std::min/max keep their first argument).
     if (a)

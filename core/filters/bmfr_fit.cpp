@@ -15,6 +15,7 @@
 #include <emmintrin.h>
 #endif
 #include "util/avx2_shuffles.h"
+#include "util/cpu_features.h"
 
 namespace mcr {
 
@@ -163,13 +164,6 @@ void scale_masked(const float* src, const float* mask, int np, float lo, float s
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define MCR_FIT_GATHER_AVX2 1
-bool has_avx2() {
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-  }();
-  return yes;
-}
 
 // The default feature set's gather (normal and position, 3 channels each, no extras) of
 // block row y for pixels [0, n8), n8 a multiple of 8, p the first pixel's index in the
@@ -272,7 +266,7 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     const float* vrow = valid + rb;
     int x = 0;
 #ifdef MCR_FIT_GATHER_AVX2
-    if (!alb && !dep && pch == 3 && nch == 3 && has_avx2()) {
+    if (!alb && !dep && pch == 3 && nch == 3 && cpu_has_avx2()) {
       x = bw / 8 * 8;
       W = gather_row_avx2(nrow, prow, irow, vrow, x, p, snp, raw, fin, zp, rows, W);
       p += x;

@@ -3,6 +3,7 @@
 #include <limits>
 
 #include "filters/bmfr_taa_cr.h"
+#include "util/cpu_features.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -35,13 +36,7 @@ MCR_AVX2 void col8(__m256 v0, __m256 v1, __m256 v2, float* s, float* q, float* m
 
 }  // namespace
 
-bool taa_avx2_available() {
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-  }();
-  return yes;
-}
+bool taa_avx2_available() { return cpu_has_avx2(); }
 
 __attribute__((target("avx2"))) int taa_stats_avx2(int x, int w, bool ycocg, const float* R, const float* G,
                                                    const float* Bc, std::size_t r0, std::size_t r1, std::size_t r2,

@@ -11,6 +11,7 @@
 #include "util/error.h"
 #include "util/parallel.h"
 #include "util/avx2_shuffles.h"
+#include "util/cpu_features.h"
 
 namespace mcr {
 
@@ -216,13 +217,6 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
   row3(y, r, crow_all, hist, hcount, af, w, orow, ncount, x);
 }
 
-bool has_avx2() {
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-  }();
-  return yes;
-}
 #endif
 
 }  // namespace
@@ -231,7 +225,7 @@ void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current,
   const int w = current.width(), h = current.height(), ch = current.channels();
   if (ch == 3) {
 #ifdef MCR_ACC_AVX2
-    if (has_avx2()) {
+    if (cpu_has_avx2()) {
       row3_avx2(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha),
                 w, next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
       return;

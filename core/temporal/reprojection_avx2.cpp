@@ -9,16 +9,11 @@
 #include <immintrin.h>
 
 #include "util/avx2_shuffles.h"
+#include "util/cpu_features.h"
 
 namespace mcr::detail {
 
-bool tap_row_avx2_available() {
-  static const bool yes = [] {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-  }();
-  return yes;
-}
+bool tap_row_avx2_available() { return cpu_has_avx2(); }
 
 namespace {
 
