@@ -213,7 +213,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
 #endif
         for (std::size_t j = j0; j < e * 3; ++j) {
           const float v = ad[j];
-          const float a = (v - v == 0.0f) ? std::max(v, lo) : 1.0f;  // v - v: NaN for NaN/Inf
+          const float a = demodulation_albedo(v, lo);
           al[j] = a;
           il[j] = co[j] / a;
         }
@@ -222,7 +222,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       for (std::size_t i = b; i < e; ++i)
         for (int c = 0; c < 3; ++c) {
           const float v = ad[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];
-          const float a = std::isfinite(v) ? std::max(v, lo) : 1.0f;
+          const float a = demodulation_albedo(v, lo);
           al[i * 3 + c] = a;
           il[i * 3 + c] = co[i * 3 + c] / a;
         }

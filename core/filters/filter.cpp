@@ -132,7 +132,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
       for (std::size_t i = b; i < e; ++i)
         for (int c = 0; c < 3; ++c) {
           const float v = a->image.data()[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];
-          const float al = std::isfinite(v) ? std::max(v, lo) : 1.0f;
+          const float al = demodulation_albedo(v, lo);
           albedo.data()[i * 3 + std::size_t(c)] = al;
           colour.data()[i * 3 + std::size_t(c)] /= al;
         }

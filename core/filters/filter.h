@@ -2,6 +2,7 @@
 // Filter interface (set -> commit -> execute), after OIDN's filter lifecycle.
 // Parameters live in a ParamSet built from the filter's one table; every input
 // check happens in commit() (parameters) and execute() (passes), nowhere else.
+#include <algorithm>
 #include <memory>
 #include <string>
 #include <vector>
@@ -41,6 +42,11 @@ struct FilterInfo {
 //   firefly_k, firefly_radius  bright outliers clamped to their window's
 //                statistics before filtering (filters/fireflies.h); 0 = off
 ParamTable with_common_params(ParamTable own);
+
+// The albedo that demodulation divides by and remodulation multiplies by: at least
+// albedo_floor, 1 where the pass is not finite (one rule for every filter and pwaf's
+// variance scaling).
+inline float demodulation_albedo(float v, float floor) { return (v - v == 0.0f) ? std::max(v, floor) : 1.0f; }
 
 struct ExecOptions {
   Roi roi;           // empty = whole frame; pixels outside keep the input colour

@@ -366,7 +366,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       if (!albedo) return 1.0;
       const Image& ai = albedo->image;
       const float v = ai.pixel(x, y)[std::min(c, ai.channels() - 1)];
-      const double a = std::isfinite(v) ? double(std::max(v, floor)) : 1.0;
+      const double a = double(demodulation_albedo(v, floor));
       return 1.0 / (a * a);
     };
     const Roi vreg = grown(stat, var_r, w, h);
