@@ -141,6 +141,23 @@ BENCHMARK(BM_bilateral)
     ->Apply(common)
     ->Iterations(1);
 
+// order=1 (first-order regression on the features): kernel size, features, threads.
+// Quadratic in the radius like order 0, with an (n+1)^2 update per tap.
+void BM_bilateral_order1(benchmark::State& state) {
+  const int r = int(state.range(0) - 1) / 2;
+  auto f = mcr::make_filter("bilateral");
+  f->set("radius", std::int64_t(r));
+  f->set("spatial_sigma", std::max(0.01, r / 3.0));
+  f->set("order", std::int64_t(1));
+  use_features(*f, int(state.range(1)));
+  run(state, *f, int(state.range(2)));
+}
+BENCHMARK(BM_bilateral_order1)
+    ->ArgsProduct({{5, 9, 13}, {3}, {2}})
+    ->ArgNames({"k", "features", "threads"})
+    ->Apply(common)
+    ->Iterations(1);
+
 // Args: k_g, iterations (cumulative time), threads. Colour + normal + position.
 void BM_atrous(benchmark::State& state) {
   auto f = mcr::make_filter("atrous");

@@ -62,7 +62,11 @@ const FilterInfo& AtrousFilter::static_info() {
         "keep their precision";
     i.sweep_param = "iterations";
     i.sweep_values = {1, 2, 3, 4, 5, 6};
-    i.sweep_variants = {"colour_weight=noise firefly_k=2"};
+    // The second: tight position/colour stops with a 3-tap kernel, the best found on the
+    // glossy scene (0.00703 there against 0.00828 for the defaults' best).
+    i.sweep_variants = {"colour_weight=noise firefly_k=2",
+                        "kernel_size=3 colour_sigma=0.7 normal_sigma=0.5 position_sigma=0.08 albedo_sigma=0.5 "
+                        "use_depth=on firefly_k=1"};
     return i;
   }();
   return info;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "filters/feature_regression.h"
 #include "filters/feature_weights.h"
 #include "filters/foveation.h"
 #include "filters/gaussian.h"
@@ -25,6 +26,14 @@ ParamTable bilateral_params() {
   t.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
                                "firefly clamp: > 0 clamps every colour channel to [-clamp, clamp] before filtering; "
                                "0 = off (the colour weight alone keeps fireflies from spreading)"));
+  t.push_back(ParamSpec::Int("order", 0, 0, 1,
+                             "0 = weighted mean (the thesis' cross-bilateral); 1 = weighted first-order regression on "
+                             "the feature passes over the same weights, the colour weight taken on the order-0 result "
+                             "(Moon et al. 2014, Bitterli et al. 2016): edge mixes and texture ramps are fitted, not "
+                             "averaged; slower (double-precision fit per pixel: about 5 s per megapixel at radius 6 on 2 cores)"));
+  t.push_back(ParamSpec::Float("ridge", 1e-3, 0.0, 1e6,
+                               "order=1: ridge on the slopes, per unit of weight (features scaled by their own "
+                               "1/(sqrt(2) sigma)); larger = closer to order 0"));
   std::vector<std::string> fov = {"spatial_sigma"};
   for (const std::string& n : feature_sigma_names()) fov.push_back(n);
   return with_common_params(with_foveation(t, fov));
@@ -46,10 +55,17 @@ const FilterInfo& BilateralFilter::static_info() {
         "is non-finite skips the colour weight, and one whose own feature f is non-finite skips f, and is then the "
         "weighted mean of its usable neighbours; a window with no usable sample keeps the pixel's colour if finite, "
         "else gives 0. Feature differences that overflow give weight 0 (never NaN); colour beyond [2^-20, 2^100] is "
-        "scaled by an exact power of two while summing, so sums never overflow and tiny values keep their precision";
+        "scaled by an exact power of two while summing, so sums never overflow and tiny values keep their precision. "
+        "order=1: the fit uses the same usable neighbours and weights (in double); a pixel whose own feature is not "
+        "finite, or whose system is singular, gets the order-0 result; the fit is clamped to the range of the window's "
+        "colours, so it never overshoots";
     i.sweep_param = "spatial_sigma";
     i.sweep_values = {1, 2, 3, 4};
-    i.sweep_variants = {"colour_weight=noise firefly_k=2"};
+    i.sweep_variants = {"colour_weight=noise firefly_k=2",
+                        "colour_sigma=0.5 normal_sigma=0.5 position_sigma=0.05 albedo_sigma=0.5 firefly_k=1",
+                        // first-order regression; the best found on the glossy scene (0.00671)
+                        "order=1 ridge=0.01 radius=6 colour_sigma=0.35 normal_sigma=0.5 position_sigma=0.08 "
+                        "albedo_sigma=1 firefly_k=1"};
     return i;
   }();
   return info;
@@ -83,7 +99,9 @@ void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& ro
     rmax = rmin = radius_at(spatial.inner);
   }
 
-  const Roi box = grow_roi(roi, rmax, w, h);
+  // order=1 takes its colour weight on the order-0 result of every pixel of its window.
+  const bool first_order = params_.get_int("order") == 1;
+  const Roi box = grow_roi(roi, first_order ? 2 * rmax : rmax, w, h);
   planar_colour(colour, box, params_.get_float("clamp"), nthreads, cp_);
   const ColourPlanes& cp = cp_;
   const PlaneBox& pb = cp.pb;
@@ -130,8 +148,33 @@ void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& ro
   pass.radius = rad.empty() ? nullptr : rad.data();
   pass.set_dense_taps(rmax);
   for (int c = 0; c < 3; ++c) pass.out[c] = res[c].data();
-  cross_filter(pass, roi, nthreads);
+  cross_filter(pass, first_order ? grow_roi(roi, rmax, w, h) : roi, nthreads);
   const float* planes[3] = {res[0].data(), res[1].data(), res[2].data()};
+  if (first_order) {
+    RegressionPass rp;
+    rp.pb = pb;
+    for (int c = 0; c < 3; ++c) {
+      rp.colour[c] = cp.c[c].data();
+      rp.guide[c] = res[c].data();
+      rp.fallback[c] = res[c].data();
+      pb.prepare(reg_[c]);
+      rp.out[c] = reg_[c].data();
+      planes[c] = reg_[c].data();
+    }
+    rp.valid = valid.data();
+    rp.colour_weight = pass.colour_weight;
+    rp.colour_a = pass.colour_a;
+    rp.colour_a_const = pass.colour_a_const;
+    rp.colour_amul = pass.colour_amul;
+    rp.features = pass.guides;
+    rp.feature_ok = guides.ok.data();
+    rp.s = pass.s;
+    rp.s_const = pass.s_const;
+    rp.radius = pass.radius;
+    rp.rmax = rmax;
+    rp.ridge = params_.get_float("ridge");
+    feature_regression(rp, roi, nthreads);
+  }
   store_colour(planes, pb, cp.scale, roi, out, nthreads);
 }
 
