@@ -64,18 +64,8 @@ Image reference(const Frame& frame, const Params& given) {
   const double decay = ps.get_float("colour_sigma_decay");
   const bool use_colour = ps.get_enum("use_colour") != "off";
   const double sc = ps.get_float("colour_sigma");
-  struct F {
-    const Image* im;
-    int ch;
-    double k;
-  };
-  std::vector<F> feats;
-  for (int i = 1; i < 5; ++i) {
-    const std::string nm = kFeatureNames[i];
-    if (ps.get_enum("use_" + nm) == "off" || !frame.has(kFeatureRoles[i])) continue;
-    const double s = ps.get_float(nm + "_sigma");
-    feats.push_back({&frame.image(kFeatureRoles[i]), i == 4 ? 1 : 3, 1.0 / (2 * s * s)});
-  }
+  using F = OracleFeature;
+  const std::vector<F> feats = oracle_features(frame, ps);
   const Image& colour = frame.image(Role::Colour);
   const std::size_t np = std::size_t(w) * h;
   std::vector<double> cur(np * 3, 0.0);

@@ -34,17 +34,8 @@ Image oracle(const Frame& frame, const Params& p) {
   const int r = int(std::ceil(3 * ss - 1e-6));
   const bool use_colour = ps.get_enum("use_colour") != "off";
   const double kc = 1.0 / (2 * std::pow(ps.get_float("colour_sigma"), 2));
-  struct F {
-    const Image* im;
-    int ch;
-    double k;
-  };
-  std::vector<F> feats;
-  for (int i = 1; i < 5; ++i) {
-    const std::string n = kFeatureNames[i];
-    if (ps.get_enum("use_" + n) == "off" || !frame.has(kFeatureRoles[i])) continue;
-    feats.push_back({&frame.image(kFeatureRoles[i]), i == 4 ? 1 : 3, 1.0 / (2 * std::pow(ps.get_float(n + "_sigma"), 2))});
-  }
+  using F = OracleFeature;
+  const std::vector<F> feats = oracle_features(frame, ps);
   int n = 1;
   for (const F& f : feats) n += f.ch;
   const Image& colour = frame.image(Role::Colour);

@@ -82,6 +82,24 @@ Result run_filter(const Frame& frame, const Params& params, int nthreads = 0, Ro
   return r;
 }
 
+// The non-colour features an oracle weighs with: each enabled pass the frame has,
+// its channel count and k = 1/(2 sigma^2), in Feature order.
+struct OracleFeature {
+  const Image* im;
+  int ch;
+  double k;
+};
+inline std::vector<OracleFeature> oracle_features(const Frame& frame, const ParamSet& ps) {
+  std::vector<OracleFeature> feats;
+  for (int i = 1; i < 5; ++i) {
+    const std::string n = kFeatureNames[i];
+    if (ps.get_enum("use_" + n) == "off" || !frame.has(kFeatureRoles[i])) continue;
+    const double s = ps.get_float(n + "_sigma");
+    feats.push_back({&frame.image(kFeatureRoles[i]), i == 4 ? 1 : 3, 1.0 / (2 * s * s)});
+  }
+  return feats;
+}
+
 inline Params all_off() {
   Params p;
   for (const char* n : kFeatureNames) p[std::string("use_") + n] = std::string("off");
