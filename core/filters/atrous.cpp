@@ -66,7 +66,9 @@ const FilterInfo& AtrousFilter::static_info() {
     // glossy scene (0.00703 there against 0.00828 for the defaults' best).
     i.sweep_variants = {"colour_weight=noise firefly_k=2",
                         "kernel_size=3 colour_sigma=0.7 normal_sigma=0.5 position_sigma=0.08 albedo_sigma=0.5 "
-                        "use_depth=on firefly_k=1"};
+                        "use_depth=on firefly_k=1",
+                        "kernel_size=3 colour_sigma=0.7 normal_sigma=0.5 position_sigma=0.08 albedo_sigma=0.5 "
+                        "use_depth=on firefly_k=1 albedo_prefilter=0.2"};
     return i;
   }();
   return info;

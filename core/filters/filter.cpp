@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "filters/albedo_prefilter.h"
 #include "filters/fireflies.h"
 #include "filters/pull_push.h"
 #include "util/error.h"
@@ -13,6 +14,13 @@ namespace mcr {
 ParamTable with_common_params(ParamTable own) {
   own.push_back(ParamSpec::Bool("demodulate", false, "divide the colour by the albedo pass before filtering and multiply after"));
   own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0, "albedo is raised to at least albedo_floor for demodulation (no upper clamp: colour is divided and multiplied by the same value, and Blender's albedo exceeds 1 on highlights)"));
+  own.push_back(ParamSpec::Float("albedo_prefilter", 0.0, 0.0, 10.0,
+                                 "smooth the albedo pass before it is used (demodulation and albedo weights): range sigma, "
+                                 "in log albedo, of a first-order cross-bilateral fit on normal and position (1 px; NFOR's "
+                                 "feature prefiltering): a 16-spp albedo carries coverage and glossy-bounce noise that "
+                                 "remodulation puts back; 0 = off"));
+  own.push_back(ParamSpec::Float("albedo_prefilter_position", 0.03, 1e-6, 1e6,
+                                 "position sigma of albedo_prefilter, in scene units"));
   own.push_back(ParamSpec::Enum("holes", "auto", {"auto", "none", "sample_count", "alpha"},
                                 "unsampled pixels to fill by pull-push first: auto = sample_count 0 when that pass exists"));
   own.push_back(ParamSpec::Float("firefly_k", 0.0, 0.0, 1e3,
@@ -93,6 +101,23 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
       if (p.role != Role::SampleCount && p.role != Role::Alpha) pull_push_fill(p.image, holes, options.nthreads);
     src = &filled;
     note("filled " + std::to_string(std::count(holes.begin(), holes.end(), 0.0f)) + " unsampled pixels by pull-push");
+  }
+  // Albedo prefilter: every later use of the albedo pass sees the smoothed one.
+  Frame prefiltered;
+  if (params_.get_float("albedo_prefilter") > 0) {
+    if (const Pass* a = src->find(Role::Albedo)) {
+      AlbedoPrefilter ap;
+      ap.range_sigma = params_.get_float("albedo_prefilter");
+      ap.position_sigma = params_.get_float("albedo_prefilter_position");
+      ap.floor = params_.get_float("albedo_floor");
+      Image smooth = prefilter_albedo(*src, *a, ap, options.nthreads);
+      const std::size_t index = std::size_t(a - src->passes.data());
+      prefiltered = *src;
+      prefiltered.passes[index].image = std::move(smooth);
+      src = &prefiltered;
+    } else {
+      note("albedo_prefilter skipped: no albedo pass in '" + frame.path + "'");
+    }
   }
   const Image& input = src->image(Role::Colour);
   const int nthreads = options.nthreads;
