@@ -39,6 +39,7 @@ Image prefilter_albedo(const Frame& frame, const Pass& albedo, const AlbedoPrefi
   bf.set("normal_sigma", 0.5);
   bf.set("position_sigma", p.position_sigma);
   bf.set("use_albedo", std::string("off"));
+  bf.set("ridge", 1e-3);  // a clean signal: slopes nearly free
   bf.commit();
   ExecOptions eo;
   eo.nthreads = nthreads;

@@ -31,9 +31,11 @@ ParamTable bilateral_params() {
                              "the feature passes over the same weights, the colour weight taken on the order-0 result "
                              "(Moon et al. 2014, Bitterli et al. 2016): edge mixes and texture ramps are fitted, not "
                              "averaged; slower (double-precision fit per pixel: about 3 s per megapixel at radius 6 on 2 cores)"));
-  t.push_back(ParamSpec::Float("ridge", 1e-3, 0.0, 1e6,
+  t.push_back(ParamSpec::Float("ridge", 0.1, 0.0, 1e6,
                                "order=1: ridge on the slopes, per unit of weight (features scaled by their own "
-                               "1/(sqrt(2) sigma)); larger = closer to order 0"));
+                               "1/(sqrt(2) sigma)); larger = closer to a weighted mean (with the colour weight still on "
+                               "the order-0 result): about 1 for very noisy renders (room, dof at 16 spp), 0.005 for "
+                               "cleaner ones (glossy)"));
   std::vector<std::string> fov = {"spatial_sigma"};
   for (const std::string& n : feature_sigma_names()) fov.push_back(n);
   return with_common_params(with_foveation(t, fov));
@@ -60,7 +62,7 @@ const FilterInfo& BilateralFilter::static_info() {
         "finite, or whose system is singular, gets the order-0 result; the fit is clamped to the range of the window's "
         "colours, so it never overshoots";
     i.sweep_param = "spatial_sigma";
-    i.sweep_values = {1, 2, 2.5, 3, 4};
+    i.sweep_values = {1, 2, 2.5, 3, 4, 5};
     i.sweep_variants = {"colour_weight=noise firefly_k=2",
                         "colour_sigma=0.5 normal_sigma=0.5 position_sigma=0.05 albedo_sigma=0.5 firefly_k=1",
                         // first-order regression, without and with the albedo prefilter: the best
@@ -68,7 +70,9 @@ const FilterInfo& BilateralFilter::static_info() {
                         "order=1 ridge=0.01 radius=6 colour_sigma=0.35 normal_sigma=0.5 position_sigma=0.08 "
                         "albedo_sigma=1 firefly_k=1",
                         "albedo_prefilter=0.2 order=1 ridge=0.005 radius=5 colour_sigma=0.45 normal_sigma=0.5 "
-                        "position_sigma=0.08 albedo_sigma=1 firefly_k=1"};
+                        "position_sigma=0.08 albedo_sigma=1 firefly_k=1",
+                        // and the noisy-render setting: a strong ridge, the order-0 result as colour guide
+                        "order=1 ridge=1 firefly_k=2", "order=1 ridge=1 firefly_k=1 albedo_prefilter=0.2"};
     return i;
   }();
   return info;
