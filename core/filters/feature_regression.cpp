@@ -1,9 +1,16 @@
 #include "filters/feature_regression.h"
 
+// The kernel's L-lane vectors only live inside code inlined into functions compiled
+// for one instruction set (see feature_weights.cpp).
+#pragma GCC diagnostic ignored "-Wpsabi"
+
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <cstring>
 
+#include "filters/simd_exp.h"
+#include "util/cpu_features.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -52,129 +59,148 @@ struct Channel {
   const Guides::Guide* g;
 };
 
-// Per-thread scratch of one window, structure of arrays (tap index innermost) so that
-// the moment sums are dot products the compiler vectorises.
-struct Window {
-  std::vector<double> x;  // N planes of taps (x[0] unused: the constant 1)
-  std::vector<double> c;  // 3 planes: the colour of each tap
-  std::vector<double> wx; // N planes: w * x
-  std::vector<float> e, w;
-  void reserve(int n, int taps) {
-    const std::size_t t = std::size_t(taps);
-    if (x.size() < std::size_t(n) * t) x.resize(std::size_t(n) * t), wx.resize(std::size_t(n) * t);
-    if (c.size() < 3 * t) c.resize(3 * t);
-    if (e.size() < t) e.resize(t), w.resize(t);
-  }
+// L consecutive pixels of a row at once, one lane each (doubles: the moment sums need
+// the precision), every tap of the window in turn; the N x N moments of the L fits
+// live in vectors, then each lane is solved on its own. Written over GCC vector
+// extensions and compiled twice (generic, AVX2): taps of consecutive pixels are
+// consecutive in every plane, so a tap is one unaligned load per plane.
+template <int L>
+struct VecD {
+  typedef double d __attribute__((vector_size(8 * L)));
 };
 
-double dot(const double* a, const double* b, int n) {
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  int t = 0;
-  for (; t + 4 <= n; t += 4) {
-    s0 += a[t] * b[t];
-    s1 += a[t + 1] * b[t + 1];
-    s2 += a[t + 2] * b[t + 2];
-    s3 += a[t + 3] * b[t + 3];
-  }
-  for (; t < n; ++t) s0 += a[t] * b[t];
-  return (s0 + s1) + (s2 + s3);
-}
-
-double sum(const double* a, int n) {
-  double s0 = 0, s1 = 0;
-  int t = 0;
-  for (; t + 2 <= n; t += 2) s0 += a[t], s1 += a[t + 1];
-  if (t < n) s0 += a[t];
-  return s0 + s1;
-}
-
-// One pixel's fit with N regressors known at compile time.
-template <int N>
-void fit_pixel(const RegressionPass& a, const Channel* ch, int px, int y, Window& win) {
+template <int N, int L>
+MCR_INLINE void fit_group(const RegressionPass& a, const Channel* ch, int px0, int lanes, int y) {
+  using vd = typename VecD<L>::d;
+  using vf = typename simd::Vec<L>::f;
   constexpr int nf = N - 1;
   const PlaneBox& pb = a.pb;
   const Roi& box = pb.box;
-  const std::size_t ip = pb.index(px, y);
-  auto fall_back = [&] {
-    for (int c = 0; c < 3; ++c) a.out[c][ip] = a.fallback[c][ip];
+  const std::size_t ip0 = pb.index(px0, y);
+  auto loadf = [&](const float* plane, std::size_t i) {
+    vf v;
+    std::memcpy(&v, plane + i, sizeof v);
+    return __builtin_convertvector(v, vd);
   };
-  if (a.feature_ok && a.feature_ok[ip] == 0.0f) return fall_back();
-  double fp[N > 1 ? nf : 1], sk[N > 1 ? nf : 1];
+  auto lane_or = [&](const float* plane, float c) {
+    vd v;
+    for (int l = 0; l < L; ++l) v[l] = plane && l < lanes ? plane[ip0 + std::size_t(l)] : (l < lanes ? c : 0.0f);
+    return v;
+  };
+  vd fp[N > 1 ? nf : 1], sk[N > 1 ? nf : 1];
   for (int j = 0; j < nf; ++j) {
     const Guides::Guide* g = ch[j].g;
-    fp[j] = ch[j].v[ip];
-    sk[j] = std::sqrt(double(g->k.empty() ? g->k_const : g->k[ip]));
+    fp[j] = lane_or(ch[j].v, 0.0f);
+    const vd k = lane_or(g->k.empty() ? nullptr : g->k.data(), g->k_const);
+    for (int l = 0; l < L; ++l) sk[j][l] = std::sqrt(k[l]);
   }
-  const double s = a.s ? a.s[ip] : a.s_const;
-  const int r = a.radius ? int(a.radius[ip]) : a.rmax;
-  const double ca = a.colour_weight ? double(a.colour_a ? a.colour_a[ip] : a.colour_a_const) * a.colour_amul : 0.0;
-  const double g0 = a.colour_weight ? a.guide[0][ip] : 0.0, g1 = a.colour_weight ? a.guide[1][ip] : 0.0,
-               g2 = a.colour_weight ? a.guide[2][ip] : 0.0;
-  const int y0 = std::max(box.y0, y - r), y1 = std::min(box.y1 - 1, y + r);
-  const int x0 = std::max(box.x0, px - r), x1 = std::min(box.x1 - 1, px + r);
-  const int cap = (y1 - y0 + 1) * (x1 - x0 + 1);
-  win.reserve(N, cap);
-  double* X = win.x.data();
-  double* C = win.c.data();
-  int T = 0;
+  const vd s = lane_or(a.s, a.s_const);
+  const vd ca = a.colour_weight ? lane_or(a.colour_a, a.colour_a_const) * double(a.colour_amul) : vd{} + 0.0;
+  vd g[3];
+  for (int c = 0; c < 3; ++c) g[c] = a.colour_weight ? lane_or(a.guide[c], 0.0f) : vd{} + 0.0;
+  // Window: the largest radius of the lanes; a lane ignores taps beyond its own.
+  vd rl;
+  int R = 0;
+  for (int l = 0; l < L; ++l) {
+    const int r = l < lanes ? (a.radius ? int(a.radius[ip0 + std::size_t(l)]) : a.rmax) : 0;
+    rl[l] = r;
+    R = std::max(R, r);
+  }
+  vd lanex;  // lane offset, and 1 for the lanes that exist
+  vd exists;
+  for (int l = 0; l < L; ++l) lanex[l] = l, exists[l] = l < lanes ? 1.0 : 0.0;
+
+  vd A[N * (N + 1) / 2], B[N * 3], wsum = vd{} + 0.0;
+  for (vd& v : A) v = vd{} + 0.0;
+  for (vd& v : B) v = vd{} + 0.0;
+  vd lo[3], hi[3];
+  for (int c = 0; c < 3; ++c) lo[c] = vd{} + DBL_MAX, hi[c] = vd{} - DBL_MAX;
+  const int y0 = std::max(box.y0, y - R), y1 = std::min(box.y1 - 1, y + R);
   for (int qy = y0; qy <= y1; ++qy) {
-    const double dy2 = double(qy - y) * double(qy - y);
-    for (int qx = x0; qx <= x1; ++qx) {
-      const std::size_t iq = pb.index(qx, qy);
-      if (a.valid[iq] == 0.0f) continue;
-      double e = s * (dy2 + double(qx - px) * double(qx - px));
+    const double dy = qy - y;
+    const vd ry = (vd{} + dy * dy) <= rl * rl ? vd{} + 1.0 : vd{} + 0.0;
+    for (int dx = -R; dx <= R; ++dx) {
+      const int qx0 = px0 + dx;  // lane l's tap is qx0 + l
+      if (qx0 + lanes - 1 < box.x0 || qx0 >= box.x1) continue;
+      // The planes' padding (kPlanePad zero columns, valid 0) covers up to 16 lanes
+      // past either edge; beyond it, lanes outside the box are read one by one.
+      const bool padded = qx0 >= box.x0 - kPlanePad && qx0 + L <= box.x1 + kPlanePad;
+      const std::size_t iq = pb.index(padded ? qx0 : std::max(qx0, box.x0), qy);
+      auto tap = [&](const float* plane) {
+        if (padded) return loadf(plane, iq);
+        vd v;
+        for (int l = 0; l < L; ++l) {
+          const int qx = qx0 + l;
+          v[l] = qx >= box.x0 && qx < box.x1 ? plane[pb.index(qx, qy)] : 0.0f;
+        }
+        return v;
+      };
+      const vd valid = tap(a.valid);
+      const vd dxl = lanex * 0.0 + double(dx);
+      const vd inr = (dxl * dxl) <= rl * rl ? vd{} + 1.0 : vd{} + 0.0;
+      vd e = s * (vd{} + (dy * dy + double(dx) * double(dx)));
+      vd x[N];
+      x[0] = vd{} + 1.0;
       for (int j = 0; j < nf; ++j) {
-        const double v = (double(ch[j].v[iq]) - fp[j]) * sk[j];
-        X[std::size_t(1 + j) * std::size_t(cap) + std::size_t(T)] = v;
-        e += v * v;
+        x[1 + j] = (tap(ch[j].v) - fp[j]) * sk[j];
+        e += x[1 + j] * x[1 + j];
       }
-      if (a.colour_weight) {
-        const double d0 = ca * (a.guide[0][iq] - g0), d1 = ca * (a.guide[1][iq] - g1), d2 = ca * (a.guide[2][iq] - g2);
-        e += d0 * d0 + d1 * d1 + d2 * d2;
+      vd cq[3];
+      for (int c = 0; c < 3; ++c) cq[c] = tap(a.colour[c]);
+      if (a.colour_weight)
+        for (int c = 0; c < 3; ++c) {
+          const vd d = ca * (tap(a.guide[c]) - g[c]);
+          e += d * d;
+        }
+      e = e < 1e30 ? e : vd{} + 1e30;  // also NaN -> 1e30 (weight 0)
+      const vd w = __builtin_convertvector(simd::exp_neg_v<L>(__builtin_convertvector(e, vf)), vd) * valid * inr *
+                   ry * exists;
+      wsum += w;
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = w > 0.0 ? (cq[c] < lo[c] ? cq[c] : lo[c]) : lo[c];
+        hi[c] = w > 0.0 ? (cq[c] > hi[c] ? cq[c] : hi[c]) : hi[c];
       }
-      win.e[std::size_t(T)] = float(std::min(e, 1e30));
-      for (int c = 0; c < 3; ++c) C[std::size_t(c) * std::size_t(cap) + std::size_t(T)] = a.colour[c][iq];
-      ++T;
+      int m = 0;
+      for (int i = 0; i < N; ++i) {
+        const vd wx = w * x[i];
+        for (int k = 0; k <= i; ++k) A[m++] += wx * x[k];
+        for (int c = 0; c < 3; ++c) B[i * 3 + c] += wx * cq[c];
+      }
     }
   }
-  fast_exp_neg_n(win.e.data(), win.w.data(), T);
-  double* WX = win.wx.data();
-  double lo[3] = {DBL_MAX, DBL_MAX, DBL_MAX}, hi[3] = {-DBL_MAX, -DBL_MAX, -DBL_MAX};
-  double wsum = 0.0;
-  for (int t = 0; t < T; ++t) {
-    const double w = win.w[std::size_t(t)];
-    WX[t] = w;
-    wsum += w;
-    if (w == 0.0) continue;  // the range clamp counts taps with weight only
-    for (int c = 0; c < 3; ++c) {
-      const double v = C[std::size_t(c) * std::size_t(cap) + std::size_t(t)];
-      lo[c] = std::min(lo[c], v);
-      hi[c] = std::max(hi[c], v);
-    }
+  for (int l = 0; l < lanes; ++l) {
+    const std::size_t ip = ip0 + std::size_t(l);
+    double Al[N * N], Bl[N * 3];
+    int m = 0;
+    for (int i = 0; i < N; ++i)
+      for (int k = 0; k <= i; ++k) Al[i * N + k] = A[m++][l];
+    for (int i = 0; i < N * 3; ++i) Bl[i] = B[i][l];
+    for (int i = 1; i < N; ++i) Al[i * N + i] += a.ridge * wsum[l];
+    const bool ok = (!a.feature_ok || a.feature_ok[ip] != 0.0f) && wsum[l] > 0.0 && cholesky_solve(Al, N, Bl);
+    for (int c = 0; c < 3; ++c)
+      a.out[c][ip] = ok ? float(std::clamp(Bl[c], lo[c][l], hi[c][l])) : a.fallback[c][ip];
   }
-  if (!(wsum > 0.0)) return fall_back();
-  for (int i = 1; i < N; ++i) {
-    const double* xi = X + std::size_t(i) * std::size_t(cap);
-    double* wxi = WX + std::size_t(i) * std::size_t(cap);
-    for (int t = 0; t < T; ++t) wxi[t] = WX[t] * xi[t];
-  }
-  double A[N * N], B[N * 3];
-  for (int i = 0; i < N; ++i) {
-    const double* wxi = WX + std::size_t(i) * std::size_t(cap);
-    A[i * N] = i == 0 ? wsum : sum(wxi, T);  // x_0 = 1
-    for (int k = 1; k <= i; ++k) A[i * N + k] = dot(wxi, X + std::size_t(k) * std::size_t(cap), T);
-    for (int c = 0; c < 3; ++c) B[i * 3 + c] = dot(wxi, C + std::size_t(c) * std::size_t(cap), T);
-  }
-  for (int i = 1; i < N; ++i) A[i * N + i] += a.ridge * wsum;
-  if (!cholesky_solve(A, N, B)) return fall_back();
-  for (int c = 0; c < 3; ++c) a.out[c][ip] = float(std::clamp(B[c], lo[c], hi[c]));
+}
+
+constexpr int kLanes = 4;
+
+template <int N>
+void rows_generic(const RegressionPass& a, const Channel* ch, int y, int x0, int x1) {
+  for (int x = x0; x < x1; x += kLanes) fit_group<N, kLanes>(a, ch, x, std::min(kLanes, x1 - x), y);
+}
+template <int N>
+__attribute__((target("avx2"), flatten)) void rows_avx2(const RegressionPass& a, const Channel* ch, int y, int x0,
+                                                        int x1) {
+  for (int x = x0; x < x1; x += kLanes) fit_group<N, kLanes>(a, ch, x, std::min(kLanes, x1 - x), y);
 }
 
 template <int N>
 void fit_rows(const RegressionPass& a, const Channel* ch, const Roi& region, int nthreads) {
+  // The AVX2 build unless the cross kernel is held to the generic one (tests).
+  const bool avx2 = cpu_has_avx2() && std::strcmp(cross_filter_isa(), "generic") != 0;
   parallel_rows(region.y0, region.y1, nthreads, [&](int y) {
-    thread_local Window win;  // grown only: no allocation per pixel
-    for (int px = region.x0; px < region.x1; ++px) fit_pixel<N>(a, ch, px, y, win);
+    if (avx2) rows_avx2<N>(a, ch, y, region.x0, region.x1);
+    else rows_generic<N>(a, ch, y, region.x0, region.x1);
   });
 }
 

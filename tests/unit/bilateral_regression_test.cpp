@@ -9,6 +9,7 @@
 
 #include "feature_filter_testutil.h"
 #include "filters/bilateral.h"
+#include "filters/feature_weights.h"
 
 namespace mcr {
 namespace {
@@ -171,6 +172,33 @@ TEST(BilateralRegression, ThreadsAndRegion) {
         const bool inside = x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1;
         ASSERT_EQ(part.at(x, y, c), inside ? one.at(x, y, c) : in.at(x, y, c)) << x << "," << y;
       }
+}
+
+// The generic and AVX2 builds of the fit against the oracle, and against each other to
+// rounding (their sums may differ in the last bits); foveated (per-pixel spatial sigma
+// and window) with the same bits for any thread count.
+TEST(BilateralRegression, EveryInstructionSetAndFoveation) {
+  const Frame f = full_frame(29, 17, 31);
+  Frame g = f;
+  pass_image(g, Role::Normal).at(3, 9, 2) = kNaN;
+  const Params fov = with(regression_params(), {{"foveated", true}, {"spatial_sigma", 0.8},
+                                                {"spatial_sigma_outer", 2.0}, {"inner_radius", 0.05}});
+  std::vector<Image> outs, fovs;
+  for (const char* isa : {"generic", "avx2"}) {
+    if (!set_cross_filter_isa(isa)) continue;
+    SCOPED_TRACE(isa);
+    outs.push_back(run_filter<BilateralFilter>(f, regression_params()).out);
+    expect_near_images(outs.back(), oracle(f, regression_params()), 2e-3);
+    fovs.push_back(run_filter<BilateralFilter>(g, fov, 1).out);
+    EXPECT_EQ(fovs.back().storage(), run_filter<BilateralFilter>(g, fov, 2).out.storage());
+    for (float v : fovs.back().storage()) ASSERT_TRUE(std::isfinite(v));
+  }
+  set_cross_filter_isa("");
+  ASSERT_GE(outs.size(), 1u);
+  for (std::size_t i = 1; i < outs.size(); ++i) {
+    expect_near_images(outs[i], outs[0], 1e-5);
+    expect_near_images(fovs[i], fovs[0], 1e-5);
+  }
 }
 
 }  // namespace
