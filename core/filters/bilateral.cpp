@@ -30,7 +30,7 @@ ParamTable bilateral_params() {
                              "0 = weighted mean (the thesis' cross-bilateral); 1 = weighted first-order regression on "
                              "the feature passes over the same weights, the colour weight taken on the order-0 result "
                              "(Moon et al. 2014, Bitterli et al. 2016): edge mixes and texture ramps are fitted, not "
-                             "averaged; slower (double-precision fit per pixel: about 3 s per megapixel at radius 6 on 2 cores)"));
+                             "averaged; slower (double-precision fit per pixel: about 2 s per megapixel at radius 6 on 2 cores)"));
   t.push_back(ParamSpec::Float("ridge", 0.1, 0.0, 1e6,
                                "order=1: ridge on the slopes, per unit of weight (features scaled by their own "
                                "1/(sqrt(2) sigma)); larger = closer to a weighted mean (with the colour weight still on "
