@@ -50,10 +50,6 @@ bool cholesky_solve(double* A, int n, double* b /* n x 3, row-major */) {
   return true;
 }
 
-}  // namespace
-
-namespace {
-
 struct Channel {
   const float* v;
   const Guides::Guide* g;
@@ -106,9 +102,8 @@ MCR_INLINE void fit_group(const RegressionPass& a, const Channel* ch, int px0, i
     rl[l] = r;
     R = std::max(R, r);
   }
-  vd lanex;  // lane offset, and 1 for the lanes that exist
-  vd exists;
-  for (int l = 0; l < L; ++l) lanex[l] = l, exists[l] = l < lanes ? 1.0 : 0.0;
+  vd exists;  // 1 for the lanes that hold a pixel
+  for (int l = 0; l < L; ++l) exists[l] = l < lanes ? 1.0 : 0.0;
 
   vd A[N * (N + 1) / 2], B[N * 3], wsum = vd{} + 0.0;
   for (vd& v : A) v = vd{} + 0.0;
@@ -136,8 +131,7 @@ MCR_INLINE void fit_group(const RegressionPass& a, const Channel* ch, int px0, i
         return v;
       };
       const vd valid = tap(a.valid);
-      const vd dxl = lanex * 0.0 + double(dx);
-      const vd inr = (dxl * dxl) <= rl * rl ? vd{} + 1.0 : vd{} + 0.0;
+      const vd inr = (vd{} + double(dx) * double(dx)) <= rl * rl ? vd{} + 1.0 : vd{} + 0.0;
       vd e = s * (vd{} + (dy * dy + double(dx) * double(dx)));
       vd x[N];
       x[0] = vd{} + 1.0;
@@ -211,6 +205,7 @@ void feature_regression(const RegressionPass& a, const Roi& region, int nthreads
   for (const Guides::Guide* g : a.features)
     for (int c = 0; c < g->channels; ++c) ch.push_back({g->c[c].data(), g});
   const Channel* c = ch.data();
+  static_assert(kMaxRegressors == 11, "one case per regressor count below");
   switch (1 + int(ch.size())) {
     case 1: return fit_rows<1>(a, c, region, nthreads);
     case 2: return fit_rows<2>(a, c, region, nthreads);

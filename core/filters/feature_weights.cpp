@@ -948,15 +948,5 @@ void cross_filter(const CrossPass& a, const Roi& region, int nthreads) {
 
 float fast_exp_neg(float e) { return exp_neg_v<8>(splat<8>(e))[0]; }
 
-void fast_exp_neg_n(const float* e, float* out, int n) {
-  int i = 0;
-  for (; i + 8 <= n; i += 8) {
-    Vec<8>::f v;
-    std::memcpy(&v, e + i, sizeof v);
-    v = exp_neg_v<8>(v);
-    std::memcpy(out + i, &v, sizeof v);
-  }
-  for (; i < n; ++i) out[i] = fast_exp_neg(e[i]);
-}
 
 }  // namespace mcr

@@ -168,7 +168,5 @@ bool set_cross_filter_isa(const std::string& name);
 
 // exp(-e) as the kernel computes it (for tests): exact 1 at 0, 0 for e >= 86 or NaN.
 float fast_exp_neg(float e);
-// out[i] = fast_exp_neg(e[i]), 8 at a time (the same values).
-void fast_exp_neg_n(const float* e, float* out, int n);
 
 }  // namespace mcr

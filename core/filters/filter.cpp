@@ -103,7 +103,6 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     note("filled " + std::to_string(std::count(holes.begin(), holes.end(), 0.0f)) + " unsampled pixels by pull-push");
   }
   // Albedo prefilter: every later use of the albedo pass sees the smoothed one.
-  Frame prefiltered;
   if (params_.get_float("albedo_prefilter") > 0) {
     if (const Pass* a = src->find(Role::Albedo)) {
       AlbedoPrefilter ap;
@@ -112,9 +111,11 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
       ap.floor = params_.get_float("albedo_floor");
       Image smooth = prefilter_albedo(*src, *a, ap, options.nthreads);
       const std::size_t index = std::size_t(a - src->passes.data());
-      prefiltered = *src;
-      prefiltered.passes[index].image = std::move(smooth);
-      src = &prefiltered;
+      if (src != &filled) {  // the hole-filled frame is already a copy of our own
+        filled = *src;
+        src = &filled;
+      }
+      filled.passes[index].image = std::move(smooth);
     } else {
       note("albedo_prefilter skipped: no albedo pass in '" + frame.path + "'");
     }
