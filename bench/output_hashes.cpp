@@ -1,0 +1,152 @@
+// Hashes of every filter's output on every sample scene, for its defaults and every
+// benchmark sweep setting (bench/sweeps.cpp): one line "scene filter setting hash" each.
+// A refactoring that promises the same results must print the same lines: compare with
+// bench/check_output_hashes.sh. The hash is FNV-1a over the float bits of the RGB result
+// (every frame of a sequence, in order).
+//   mcrecon_output_hashes [--scenes a,b] [--filters a,b] [--threads N]
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <cmath>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "filters/feature_weights.h"
+#include "filters/registry.h"
+#include "io/sample_manifest.h"
+#include "pipeline/evaluate.h"
+#include "sweeps.h"
+#include "temporal/accumulation.h"
+#include "util/error.h"
+
+namespace {
+
+std::vector<std::string> split(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+bool wanted(const std::vector<std::string>& list, const std::string& name) {
+  if (list.empty()) return true;
+  for (const auto& s : list)
+    if (s == name) return true;
+  return false;
+}
+
+struct Fnv {
+  std::uint64_t h = 1469598103934665603ull;
+  void add(const mcr::Image& im) {
+    for (float f : im.storage()) {
+      std::uint32_t u;
+      std::memcpy(&u, &f, 4);
+      for (int b = 0; b < 4; ++b) {
+        h ^= (u >> (8 * b)) & 0xffu;
+        h *= 1099511628211ull;
+      }
+    }
+  }
+};
+
+// The RGB of a frame's colour pass replaced by `rgb` (alpha and other channels kept).
+mcr::Frame with_colour(const mcr::Frame& frame, const mcr::Image& rgb) {
+  mcr::Frame f = frame;
+  mcr::Pass colour = f.get(mcr::Role::Colour);
+  const int ch = colour.image.channels();
+  for (std::size_t i = 0; i < rgb.pixel_count(); ++i)
+    for (int c = 0; c < 3; ++c) colour.image.data()[i * std::size_t(ch) + std::size_t(c)] = rgb.data()[i * 3 + std::size_t(c)];
+  f.put(std::move(colour));
+  return f;
+}
+
+std::string hash_of(const mcr::LoadedScene& scene, mcr::Filter& filter, bool accumulate, int threads) {
+  filter.reset();
+  mcr::TemporalAccumulator acc;
+  Fnv fnv;
+  mcr::ExecOptions eo;
+  eo.nthreads = threads;
+  for (const mcr::Frame& frame : scene.frames) {
+    if (accumulate) {
+      const mcr::Image& c = frame.image(mcr::Role::Colour);
+      const mcr::Image rgb = c.channels() == 3 ? c : c.channel_range(0, 3);
+      fnv.add(filter.execute(with_colour(frame, acc.accumulate(frame, rgb, threads)), eo));
+    } else {
+      fnv.add(filter.execute(frame, eo));
+    }
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(fnv.h));
+  return buf;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int threads = 0;
+  std::vector<std::string> scenes_wanted, filters_wanted;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (i + 1 >= argc) { std::fprintf(stderr, "%s needs a value\n", a.c_str()); return 2; }
+    const std::string v = argv[++i];
+    if (a == "--threads") threads = std::stoi(v);
+    else if (a == "--scenes") scenes_wanted = split(v);
+    else if (a == "--filters") filters_wanted = split(v);
+    else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
+  }
+  try {
+    std::printf("isa %s\n", mcr::cross_filter_isa());
+    for (const mcr::SampleScene& scene : mcr::load_sample_manifest(mcr::default_samples_dir())) {
+      if (!wanted(scenes_wanted, scene.name)) continue;
+      const int spp = scene.is_sequence() ? scene.noisy.begin()->first : 16;
+      const mcr::LoadedScene loaded = mcr::load_scene(scene, spp);
+      for (const std::string& name : mcr::filter_names()) {
+        if (!wanted(filters_wanted, name)) continue;
+        const mcr::FilterInfo& info = mcr::filter_info(name);
+        // Temporal filters run on sequences; image filters on stills with their whole sweep,
+        // on sequences with their defaults, alone and after accumulation.
+        if (info.temporal != scene.is_sequence() && info.temporal) continue;
+        const mcr::bench::Sweep& sweep = mcr::bench::sweep_for(name);
+        const bool full = info.temporal || !scene.is_sequence();
+        std::vector<double> values = sweep.values;
+        if (!full || values.empty() || sweep.param.empty()) values = {std::nan("")};
+        std::vector<std::string> variants = full ? mcr::bench::sweep_variants(name) : std::vector<std::string>{""};
+        for (const std::string& variant : variants)
+          for (bool demod : {false, true}) {
+            if (demod && !loaded.frames.front().has(mcr::Role::Albedo)) continue;
+            for (double v : values) {
+              auto filter = mcr::make_filter(name);
+              std::string setting = demod ? "demod" : "";
+              std::stringstream vs(variant);
+              for (std::string kv; vs >> kv;) {
+                const std::size_t eq = kv.find('=');
+                filter->set_text(kv.substr(0, eq), kv.substr(eq + 1));
+                setting += (setting.empty() ? "" : " ") + kv;
+              }
+              if (!std::isnan(v)) {
+                filter->set(sweep.param, v);
+                setting += (setting.empty() ? "" : " ") + sweep.param + "=" +
+                           mcr::param_value_text(filter->params().values().at(sweep.param));
+              }
+              filter->set("demodulate", demod);
+              filter->commit();
+              if (!filter->missing_passes(loaded.frames.front()).empty()) break;
+              if (setting.empty()) setting = "defaults";
+              std::printf("%s %s [%s] %s\n", scene.name.c_str(), name.c_str(), setting.c_str(),
+                          hash_of(loaded, *filter, false, threads).c_str());
+              if (scene.is_sequence() && !info.temporal)
+                std::printf("%s %s [accumulate %s] %s\n", scene.name.c_str(), name.c_str(), setting.c_str(),
+                            hash_of(loaded, *filter, true, threads).c_str());
+              std::fflush(stdout);
+            }
+          }
+      }
+    }
+  } catch (const mcr::Error& e) {
+    std::fprintf(stderr, "mcrecon_output_hashes: %s\n", e.what());
+    return 2;
+  }
+  return 0;
+}
