@@ -30,7 +30,7 @@
 
 #include <OpenImageIO/imageio.h>
 
-#include "filters/bmfr.h"
+#include "filters/temporal/bmfr.h"
 #include "filters/registry.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"

@@ -13,8 +13,9 @@
 #include <vector>
 #include <random>
 
-#include "filters/feature_weights.h"
+#include "kernels/cross_bilateral.h"
 #include "filters/registry.h"
+#include "util/isa.h"
 
 namespace {
 
@@ -81,7 +82,7 @@ void run(benchmark::State& state, mcr::Filter& filter, int threads) {
   filter.execute(frame, opt);  // warm-up: scratch planes allocated once, as for a video
   for (auto _ : state) benchmark::DoNotOptimize(filter.execute(frame, opt));
   state.SetItemsProcessed(state.iterations() * std::int64_t(kSize) * kSize);
-  state.SetLabel(mcr::cross_filter_isa());
+  state.SetLabel(mcr::isa_name(mcr::isa()));
 }
 
 void use_features(mcr::Filter& f, int count) {
@@ -178,11 +179,12 @@ BENCHMARK(BM_atrous)
 // The three builds of the cross kernel on this CPU (0 generic, 1 avx2, 2 avx512)
 // for the two targets: atrous 5 passes k_g 5 and bilateral radius 8, 3 features.
 void BM_isa(benchmark::State& state) {
-  const char* names[3] = {"generic", "avx2", "avx512"};
-  if (!mcr::set_cross_filter_isa(names[state.range(0)])) {
+  const mcr::Isa level = mcr::Isa(state.range(0));
+  if (int(level) > int(mcr::best_isa())) {
     state.SkipWithError("instruction set not available on this CPU");
     return;
   }
+  const mcr::ScopedIsa use(level);
   auto f = mcr::make_filter(state.range(1) ? "bilateral" : "atrous");
   if (state.range(1)) {
     f->set("radius", std::int64_t(8));
@@ -193,7 +195,6 @@ void BM_isa(benchmark::State& state) {
   }
   use_features(*f, 3);
   run(state, *f, int(state.range(2)));
-  mcr::set_cross_filter_isa("");
 }
 BENCHMARK(BM_isa)
     ->ArgsProduct({{0, 1, 2}, {0, 1}, {1}})

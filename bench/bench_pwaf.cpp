@@ -21,7 +21,7 @@
 #include <utility>
 #include <vector>
 
-#include "filters/pwaf.h"
+#include "filters/image/pwaf.h"
 #include "filters/registry.h"
 #include "io/sample_manifest.h"
 #include "pipeline/evaluate.h"

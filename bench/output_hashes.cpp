@@ -12,13 +12,13 @@
 #include <string>
 #include <vector>
 
-#include "filters/feature_weights.h"
 #include "filters/registry.h"
 #include "io/sample_manifest.h"
 #include "pipeline/evaluate.h"
 #include "sweeps.h"
 #include "temporal/accumulation.h"
 #include "util/error.h"
+#include "util/isa.h"
 
 namespace {
 
@@ -97,7 +97,7 @@ int main(int argc, char** argv) {
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
   }
   try {
-    std::printf("isa %s\n", mcr::cross_filter_isa());
+    std::printf("isa %s\n", mcr::isa_name(mcr::isa()));
     for (const mcr::SampleScene& scene : mcr::load_sample_manifest(mcr::default_samples_dir())) {
       if (!wanted(scenes_wanted, scene.name)) continue;
       const int spp = scene.is_sequence() ? scene.noisy.begin()->first : 16;

@@ -7,7 +7,7 @@
 #include "commands.h"
 #include "io/atomic_write.h"
 #include "io/sequence.h"
-#include "pipeline/denoise_file.h"
+#include "pipeline/denoise_session.h"
 #include "progress.h"
 #include "temporal/accumulation.h"
 #include "util/error.h"

@@ -29,7 +29,7 @@
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
 #include "io/spec_window.h"
-#include "pipeline/denoise_file.h"
+#include "pipeline/denoise_session.h"
 #include "request.h"
 #include "util/error.h"
 

@@ -16,7 +16,7 @@
 
 #include "filters/registry.h"
 #include "io/sequence.h"
-#include "pipeline/denoise_file.h"
+#include "pipeline/denoise_session.h"
 #include "util/error.h"
 
 namespace py = pybind11;

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "filters/albedo_prefilter.h"
-#include "filters/fireflies.h"
-#include "filters/pull_push.h"
+#include "prepare/albedo_prefilter.h"
+#include "prepare/fireflies.h"
+#include "prepare/pull_push.h"
 #include "util/error.h"
 #include "util/parallel.h"
 

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "filters/params.h"
+#include "util/params.h"
 #include "image/pass.h"
 
 namespace mcr {

@@ -1,12 +1,12 @@
 #include "filters/registry.h"
 
-#include "filters/atrous.h"
-#include "filters/bilateral.h"
-#include "filters/bmfr.h"
-#include "filters/box.h"
-#include "filters/guided.h"
-#include "filters/gaussian.h"
-#include "filters/pwaf.h"
+#include "filters/image/atrous.h"
+#include "filters/image/bilateral.h"
+#include "filters/temporal/bmfr.h"
+#include "filters/image/box.h"
+#include "filters/image/guided.h"
+#include "filters/image/gaussian.h"
+#include "filters/image/pwaf.h"
 #include "util/error.h"
 
 namespace mcr {

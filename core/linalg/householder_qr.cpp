@@ -1,5 +1,7 @@
 #include "linalg/householder_qr.h"
 
+#include "util/isa.h"
+
 #include <algorithm>
 #include <cmath>
 
@@ -75,15 +77,8 @@ inline __attribute__((always_inline)) void reflect_update(const double* v, doubl
 }  // namespace
 
 // The Householder updates are long dot products and axpys over the block's rows: built
-// for AVX2 as well where the compiler and loader support it (picked at load time).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define MCR_QR_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MCR_QR_CLONES
-#endif
-
-MCR_QR_CLONES
-int AugmentedQr::factorize(double* a, int rows, int features, int rhs, const QrOptions& opt) {
+// for AVX2 as well (util/isa.h; no FMA: the same bits).
+MCR_ALWAYS_INLINE int AugmentedQr::factorize_body(double* a, int rows, int features, int rhs, const QrOptions& opt) {
   features_ = features;
   rhs_ = rhs;
   rank_ = 0;
@@ -151,6 +146,16 @@ int AugmentedQr::factorize(double* a, int rows, int features, int rhs, const QrO
   for (int i = 0; i < rank_; ++i)
     for (int k = 0; k < cols; ++k) r_[std::size_t(i) * cols + k] = a[std::size_t(k) * rows + i];
   return rank_;
+}
+MCR_TARGET_AVX2 int AugmentedQr::factorize_avx2(double* a, int rows, int features, int rhs, const QrOptions& opt) {
+  return factorize_body(a, rows, features, rhs, opt);
+}
+int AugmentedQr::factorize_generic(double* a, int rows, int features, int rhs, const QrOptions& opt) {
+  return factorize_body(a, rows, features, rhs, opt);
+}
+int AugmentedQr::factorize(double* a, int rows, int features, int rhs, const QrOptions& opt) {
+  return isa_at_least(Isa::Avx2) ? factorize_avx2(a, rows, features, rhs, opt)
+                                 : factorize_generic(a, rows, features, rhs, opt);
 }
 
 void AugmentedQr::solve(int k, double* coeffs) const {

@@ -36,6 +36,10 @@ class AugmentedQr {
   bool kept(int j) const { return kept_[std::size_t(j)] != 0; }
 
  private:
+  // One body, built generic and AVX2 (util/isa.h picks).
+  int factorize_body(double* a, int rows, int features, int rhs, const QrOptions& opt);
+  int factorize_generic(double* a, int rows, int features, int rhs, const QrOptions& opt);
+  int factorize_avx2(double* a, int rows, int features, int rhs, const QrOptions& opt);
   int features_ = 0, rhs_ = 0, rank_ = 0;
   std::vector<double> r_;    // rank x (features + rhs), row-major: row i of R restricted to used rows
   std::vector<int> pivot_col_;  // for each R row, the feature column it belongs to

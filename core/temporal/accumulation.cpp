@@ -11,7 +11,7 @@
 #include "util/error.h"
 #include "util/parallel.h"
 #include "util/avx2_shuffles.h"
-#include "util/cpu_features.h"
+#include "util/isa.h"
 
 namespace mcr {
 
@@ -225,7 +225,7 @@ void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current,
   const int w = current.width(), h = current.height(), ch = current.channels();
   if (ch == 3) {
 #ifdef MCR_ACC_AVX2
-    if (cpu_has_avx2()) {
+    if (isa_at_least(Isa::Avx2)) {
       row3_avx2(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha),
                 w, next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
       return;

@@ -9,11 +9,11 @@
 #include <immintrin.h>
 
 #include "util/avx2_shuffles.h"
-#include "util/cpu_features.h"
+#include "util/isa.h"
 
 namespace mcr::detail {
 
-bool tap_row_avx2_available() { return cpu_has_avx2(); }
+bool tap_row_avx2_available() { return isa_at_least(Isa::Avx2); }
 
 namespace {
 

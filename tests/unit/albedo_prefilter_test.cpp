@@ -1,7 +1,7 @@
 // Albedo prefiltering (common parameter albedo_prefilter): texture edges of a clean
 // albedo survive exactly, multiplicative noise on a flat albedo shrinks, non-finite
 // albedo keeps the demodulation policy, and every filter stays finite with it.
-#include "filters/albedo_prefilter.h"
+#include "prepare/albedo_prefilter.h"
 
 #include <gtest/gtest.h>
 
@@ -9,7 +9,7 @@
 #include <random>
 
 #include "feature_filter_testutil.h"
-#include "filters/box.h"
+#include "filters/image/box.h"
 #include "filters/registry.h"
 
 namespace mcr {

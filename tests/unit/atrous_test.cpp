@@ -1,6 +1,6 @@
 // Edge-avoiding A-Trous against a brute-force double-precision cascade of the
 // dilated generating kernels (Dammertz et al. 2010) with the documented policy.
-#include "filters/atrous.h"
+#include "filters/image/atrous.h"
 
 #include <gtest/gtest.h>
 
@@ -11,10 +11,11 @@
 #include <random>
 #include <vector>
 
-#include "filters/feature_weights.h"
+#include "kernels/cross_bilateral.h"
 #include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
+#include "util/isa.h"
 
 namespace mcr {
 namespace {
@@ -385,14 +386,14 @@ TEST(AtrousFilterTest, EveryInstructionSetMatchesTheReference) {
   const Params p = {{"iterations", std::int64_t(3)}, {"use_depth", std::string("on")}, {"normal_sigma", 0.9},
                     {"position_sigma", 1.2}, {"albedo_sigma", 0.6}};
   int ran = 0;
-  for (const char* isa : {"generic", "avx2", "avx512"}) {
-    if (!set_cross_filter_isa(isa)) continue;
-    SCOPED_TRACE(isa);
+  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
+    if (int(level) > int(best_isa())) continue;
+    const ScopedIsa use(level);
+    SCOPED_TRACE(isa_name(level));
     expect_close(run_on(f, p).out, reference(f, p), 1e-4);
     EXPECT_EQ(run_on(f, p, 1).out.storage(), run_on(f, p, 2).out.storage());
     ++ran;
   }
-  set_cross_filter_isa("");
   EXPECT_GE(ran, 1);
 }
 

@@ -8,8 +8,9 @@
 #include <cmath>
 
 #include "feature_filter_testutil.h"
-#include "filters/bilateral.h"
-#include "filters/feature_weights.h"
+#include "filters/image/bilateral.h"
+#include "kernels/cross_bilateral.h"
+#include "util/isa.h"
 
 namespace mcr {
 namespace {
@@ -184,16 +185,16 @@ TEST(BilateralRegression, EveryInstructionSetAndFoveation) {
   const Params fov = with(regression_params(), {{"foveated", true}, {"spatial_sigma", 0.8},
                                                 {"spatial_sigma_outer", 2.0}, {"inner_radius", 0.05}});
   std::vector<Image> outs, fovs;
-  for (const char* isa : {"generic", "avx2"}) {
-    if (!set_cross_filter_isa(isa)) continue;
-    SCOPED_TRACE(isa);
+  for (Isa level : {Isa::Generic, Isa::Avx2}) {
+    if (int(level) > int(best_isa())) continue;
+    const ScopedIsa use(level);
+    SCOPED_TRACE(isa_name(level));
     outs.push_back(run_filter<BilateralFilter>(f, regression_params()).out);
     expect_near_images(outs.back(), oracle(f, regression_params()), 2e-3);
     fovs.push_back(run_filter<BilateralFilter>(g, fov, 1).out);
     EXPECT_EQ(fovs.back().storage(), run_filter<BilateralFilter>(g, fov, 2).out.storage());
     for (float v : fovs.back().storage()) ASSERT_TRUE(std::isfinite(v));
   }
-  set_cross_filter_isa("");
   ASSERT_GE(outs.size(), 1u);
   for (std::size_t i = 1; i < outs.size(); ++i) {
     expect_near_images(outs[i], outs[0], 1e-5);

@@ -1,7 +1,7 @@
 // Cross-bilateral filter against a brute-force double-precision reference of
 //   w(p,q) = exp(-|q-p|^2/(2 s^2)) prod_f exp(-|f(p)-f(q)|^2/(2 sigma_f^2))
 // with the documented non-finite policy, plus closed forms and stress cases.
-#include "filters/bilateral.h"
+#include "filters/image/bilateral.h"
 
 #include <gtest/gtest.h>
 
@@ -12,11 +12,12 @@
 #include <random>
 #include <vector>
 
-#include "filters/feature_weights.h"
-#include "filters/foveation.h"
+#include "kernels/cross_bilateral.h"
+#include "kernels/foveation.h"
 #include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
+#include "util/isa.h"
 
 namespace mcr {
 namespace {
@@ -377,17 +378,17 @@ TEST(BilateralFilterTest, EveryInstructionSetMatchesTheReference) {
   const Params fov = with(p, {{"foveated", true}, {"spatial_sigma", 0.6}, {"spatial_sigma_outer", 2.0},
                               {"colour_sigma_outer", 1.5}, {"inner_radius", 0.05}});
   int ran = 0;
-  for (const char* isa : {"generic", "avx2", "avx512"}) {
-    if (!set_cross_filter_isa(isa)) continue;
-    SCOPED_TRACE(isa);
-    EXPECT_STREQ(cross_filter_isa(), isa);
+  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
+    if (int(level) > int(best_isa())) continue;
+    const ScopedIsa use(level);
+    SCOPED_TRACE(isa_name(level));
+    EXPECT_EQ(isa(), level);
     expect_close(run_on(f, p).out, reference(f, p), 1e-4);
     EXPECT_EQ(run_on(f, fov, 1).out.storage(), run_on(f, fov, 2).out.storage());
     ++ran;
   }
-  set_cross_filter_isa("");
   EXPECT_GE(ran, 1);
-  EXPECT_FALSE(set_cross_filter_isa("neon512"));
+  EXPECT_THROW(parse_isa("neon512", "MCRECON_ISA"), Error);
 }
 
 TEST(BilateralFilterTest, TableAndPolicy) {

@@ -1,6 +1,6 @@
 // BMFR: exact fits of colours that are linear in the features, stress inputs, thread
 // independence, camera cuts and the parameter rules.
-#include "filters/bmfr.h"
+#include "filters/temporal/bmfr.h"
 
 #include <gtest/gtest.h>
 

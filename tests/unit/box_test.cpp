@@ -1,5 +1,5 @@
 // Box filter against closed forms and a plain brute-force window loop.
-#include "filters/box.h"
+#include "filters/image/box.h"
 
 #include <gtest/gtest.h>
 

@@ -1,5 +1,5 @@
 // Firefly suppression (filters/fireflies.h) against hand-computed window statistics.
-#include "filters/fireflies.h"
+#include "prepare/fireflies.h"
 
 #include <gtest/gtest.h>
 

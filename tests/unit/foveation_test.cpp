@@ -1,6 +1,6 @@
 // Foveation (Immonen 2017, fig. 5.1): the parameter table helper, the blend
 // between the inner and outer sets, and its effect on the three filters.
-#include "filters/foveation.h"
+#include "kernels/foveation.h"
 
 #include <gtest/gtest.h>
 

@@ -1,6 +1,6 @@
 // Gaussian (Simple Blur) against a brute-force 2D convolution, on both paths:
 // separable (constant sigma) and per-pixel (foveated sigma).
-#include "filters/gaussian.h"
+#include "filters/image/gaussian.h"
 
 #include <gtest/gtest.h>
 
@@ -11,11 +11,12 @@
 #include <random>
 #include <vector>
 
-#include "filters/feature_weights.h"
-#include "filters/foveation.h"
+#include "kernels/cross_bilateral.h"
+#include "kernels/foveation.h"
 #include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
+#include "util/isa.h"
 
 namespace mcr {
 namespace {
@@ -254,14 +255,14 @@ TEST(GaussianFilterTest, FoveatedPathOnEveryInstructionSet) {
   for (const auto& [k, v] : p) f.set(k, v);
   const Foveation fov(f.params(), 37, 29);
   int ran = 0;
-  for (const char* isa : {"generic", "avx2", "avx512"}) {
-    if (!set_cross_filter_isa(isa)) continue;
-    SCOPED_TRACE(isa);
+  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
+    if (int(level) > int(best_isa())) continue;
+    const ScopedIsa use(level);
+    SCOPED_TRACE(isa_name(level));
     expect_brute(in, run_on(frame_of(in), p).out, [&](int x, int y) { return fov.value("sigma", fov.blend_at(x, y)); },
                  1e-4);
     ++ran;
   }
-  set_cross_filter_isa("");
   EXPECT_GE(ran, 1);
 }
 

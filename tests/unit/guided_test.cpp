@@ -2,7 +2,7 @@
 // (constant guide, tiny epsilon with the colour as its own guide, constant colour,
 // guide offsets), and numerical stress (extreme values, NaN/Inf, tiny images,
 // threads, roi, fireflies).
-#include "filters/guided.h"
+#include "filters/image/guided.h"
 
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@
 #include <string>
 #include <vector>
 
-#include "filters/box.h"
+#include "filters/image/box.h"
 #include "filters/registry.h"
 #include "util/error.h"
 

@@ -1,6 +1,6 @@
 // Noise-relative colour weight (filters/noise_weight.h): the variance estimate against
 // closed forms, and the filters' colour_weight=noise against invariances it must have.
-#include "filters/noise_weight.h"
+#include "kernels/noise_relative_colour.h"
 
 #include <gtest/gtest.h>
 
@@ -8,8 +8,8 @@
 #include <random>
 
 #include "feature_filter_testutil.h"
-#include "filters/atrous.h"
-#include "filters/bilateral.h"
+#include "filters/image/atrous.h"
+#include "filters/image/bilateral.h"
 
 namespace mcr {
 namespace {

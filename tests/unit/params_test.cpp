@@ -1,5 +1,5 @@
 // ParamSet: parsing, types, ranges and unknown names, with their error codes and messages.
-#include "filters/params.h"
+#include "util/params.h"
 
 #include <gtest/gtest.h>
 

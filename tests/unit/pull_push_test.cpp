@@ -3,7 +3,7 @@
 #include <cmath>
 #include <random>
 
-#include "filters/pull_push.h"
+#include "prepare/pull_push.h"
 #include "filters/registry.h"
 #include "sparse/expanded_grid.h"
 

@@ -1,7 +1,7 @@
 // Point-wise adaptive filter (Guo & Pan 2012): each rule on its own (variance estimate,
 // radius mapping, outlier replacement), the filter against a brute-force weighted mean,
 // feature edges, notes about dropped weights, and numerical stress.
-#include "filters/pwaf.h"
+#include "filters/image/pwaf.h"
 
 #include <gtest/gtest.h>
 

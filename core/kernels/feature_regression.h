@@ -13,7 +13,7 @@
 // scaled by their own weight's 1/(sqrt(2) sigma), so lambda is unit-free.
 #include <vector>
 
-#include "filters/feature_weights.h"
+#include "kernels/cross_bilateral.h"
 
 namespace mcr {
 

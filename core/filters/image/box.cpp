@@ -1,4 +1,4 @@
-#include "filters/box.h"
+#include "filters/image/box.h"
 
 #include <algorithm>
 #include <cmath>

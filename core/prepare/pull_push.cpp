@@ -1,4 +1,4 @@
-#include "filters/pull_push.h"
+#include "prepare/pull_push.h"
 
 #include <algorithm>
 #include <cmath>

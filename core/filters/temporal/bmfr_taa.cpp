@@ -14,9 +14,9 @@
 #include <cmath>
 #include <limits>
 
-#include "filters/bmfr.h"
-#include "filters/bmfr_taa_avx2.h"
-#include "filters/bmfr_taa_cr.h"
+#include "filters/temporal/bmfr.h"
+#include "filters/temporal/bmfr_taa_avx2.h"
+#include "filters/temporal/bmfr_taa_cr.h"
 #include "util/parallel.h"
 
 #if defined(__SSE2__)

@@ -1,5 +1,5 @@
 #pragma once
-#include "filters/feature_weights.h"
+#include "kernels/cross_bilateral.h"
 #include "filters/filter.h"
 
 namespace mcr {

@@ -1,4 +1,4 @@
-#include "filters/params.h"
+#include "util/params.h"
 
 #include <cerrno>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "pipeline/denoise_file.h"
+#include "pipeline/denoise_session.h"
 
 #include <chrono>
 

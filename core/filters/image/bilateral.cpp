@@ -1,13 +1,13 @@
-#include "filters/bilateral.h"
+#include "filters/image/bilateral.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "filters/feature_regression.h"
-#include "filters/feature_weights.h"
-#include "filters/foveation.h"
-#include "filters/gaussian.h"
-#include "filters/noise_weight.h"
+#include "kernels/feature_regression.h"
+#include "kernels/cross_bilateral.h"
+#include "kernels/foveation.h"
+#include "filters/image/gaussian.h"
+#include "kernels/noise_relative_colour.h"
 #include "util/parallel.h"
 
 namespace mcr {

@@ -23,8 +23,8 @@
 #include <cstddef>
 #include <vector>
 
-#include "filters/feature_weights.h"
-#include "filters/params.h"
+#include "kernels/cross_bilateral.h"
+#include "util/params.h"
 #include "image/image.h"
 #include "image/pass.h"
 

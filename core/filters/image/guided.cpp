@@ -1,4 +1,4 @@
-#include "filters/guided.h"
+#include "filters/image/guided.h"
 
 #include <algorithm>
 #include <array>

@@ -1,10 +1,10 @@
-#include "filters/noise_weight.h"
+#include "kernels/noise_relative_colour.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
 
-#include "filters/pwaf.h"
+#include "filters/image/pwaf.h"
 #include "util/parallel.h"
 
 namespace mcr {

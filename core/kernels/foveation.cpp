@@ -1,4 +1,4 @@
-#include "filters/foveation.h"
+#include "kernels/foveation.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "filters/feature_weights.h"
+#include "kernels/cross_bilateral.h"
 
 // The kernel's W-lane vectors only live inside always-inlined code of functions
 // compiled for the matching instruction set; GCC warns that returning them would
@@ -15,8 +15,9 @@
 #include <type_traits>
 #include <utility>
 
-#include "filters/simd_exp.h"
+#include "kernels/simd_exp.h"
 #include "util/error.h"
+#include "util/isa.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -114,19 +115,13 @@ void PlaneBox::prepare(std::vector<float>& v, float fill) const {
 
 namespace {
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define MCR_CLONES __attribute__((target_clones("avx512f", "avx2", "default")))
-#else
-#define MCR_CLONES
-#endif
-
 // One row of n pixels of a 3-channel image into three planes, branch-free so that
 // it vectorises: a pixel with a non-finite channel (|v| <= FLT_MAX fails for NaN
 // and inf) becomes 0 with ok 0; finite channels are clamped to [-lim, lim].
 // Returns the largest |value| written, as its bit pattern (an unsigned max
 // vectorises where a float max would need -ffast-math).
-MCR_CLONES std::uint32_t split_rgb3(const float* __restrict v, int n, float lim, float* __restrict c0,
-                                    float* __restrict c1, float* __restrict c2, float* __restrict ok) {
+MCR_ALWAYS_INLINE std::uint32_t split_rgb3_body(const float* __restrict v, int n, float lim, float* __restrict c0,
+                                                float* __restrict c1, float* __restrict c2, float* __restrict ok) {
   std::uint32_t mb = 0;
   for (int x = 0; x < n; ++x) {
     const float r = v[3 * x], g = v[3 * x + 1], b = v[3 * x + 2];
@@ -146,6 +141,10 @@ MCR_CLONES std::uint32_t split_rgb3(const float* __restrict v, int n, float lim,
   }
   return mb;
 }
+MCR_ISA_VERSIONS(std::uint32_t, split_rgb3,
+                 (const float* __restrict v, int n, float lim, float* __restrict c0, float* __restrict c1,
+                  float* __restrict c2, float* __restrict ok),
+                 (v, n, lim, c0, c1, c2, ok))
 
 // The same for any channel count (the first `planes` channels, the last one
 // repeated when the image has fewer), not vectorised.
@@ -166,9 +165,10 @@ std::uint32_t split_any(const float* v, int ch, int n, int planes, float lim, fl
   return mb;
 }
 
-MCR_CLONES void scale_row(float* __restrict v, int n, float s) {
+MCR_ALWAYS_INLINE void scale_row_body(float* __restrict v, int n, float s) {
   for (int x = 0; x < n; ++x) v[x] *= s;
 }
+MCR_ISA_VERSIONS(void, scale_row, (float* __restrict v, int n, float s), (v, n, s))
 
 }  // namespace
 
@@ -204,14 +204,18 @@ void planar_colour(const Image& colour, const Roi& box, double clamp, int nthrea
 
 namespace {
 
-MCR_CLONES void merge_rgb3(const float* __restrict c0, const float* __restrict c1, const float* __restrict c2, int n,
-                           float inv, float* __restrict o) {
+MCR_ALWAYS_INLINE void merge_rgb3_body(const float* __restrict c0, const float* __restrict c1,
+                                       const float* __restrict c2, int n, float inv, float* __restrict o) {
   for (int x = 0; x < n; ++x) {
     o[3 * x + 0] = std::min(std::max(c0[x] * inv, -FLT_MAX), FLT_MAX);
     o[3 * x + 1] = std::min(std::max(c1[x] * inv, -FLT_MAX), FLT_MAX);
     o[3 * x + 2] = std::min(std::max(c2[x] * inv, -FLT_MAX), FLT_MAX);
   }
 }
+MCR_ISA_VERSIONS(void, merge_rgb3,
+                 (const float* __restrict c0, const float* __restrict c1, const float* __restrict c2, int n, float inv,
+                  float* __restrict o),
+                 (c0, c1, c2, n, inv, o))
 
 }  // namespace
 
@@ -823,8 +827,7 @@ void row_generic(const CrossPass& a, int y0, int y1, int ys, int x0, int x1) {
   cross_rows_impl<4, C, N3>(a, y0, y1, ys, x0, x1);
 }
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-#define MCR_X86_DISPATCH 1
+#ifdef MCR_X86_DISPATCH
 // Same source; the attributes let GCC use the wider registers and contract a*b+c to FMA.
 template <bool C, int N3>
 __attribute__((target("avx2,fma"), optimize("fp-contract=fast"), flatten)) void row_avx2(const CrossPass& a, int y0,
@@ -839,24 +842,6 @@ __attribute__((target("avx512f,fma"), optimize("fp-contract=fast"), flatten)) vo
   cross_rows_impl<16, C, N3>(a, y0, y1, ys, x0, x1);
 }
 #endif
-
-enum class Isa { Generic, Avx2, Avx512 };
-
-Isa best_isa() {
-#ifdef MCR_X86_DISPATCH
-  __builtin_cpu_init();
-  if (__builtin_cpu_supports("avx512f")) return Isa::Avx512;
-  if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return Isa::Avx2;
-#endif
-  return Isa::Generic;
-}
-
-std::atomic<int>& isa_choice() {
-  static std::atomic<int> choice{int(best_isa())};
-  return choice;
-}
-
-Isa isa() { return Isa(isa_choice().load(std::memory_order_relaxed)); }
 
 // Index: bit 2 colour weight, bits 0-1 number of three-channel guides.
 template <template <bool, int> class Row, std::size_t... I>
@@ -894,27 +879,6 @@ RowFn pick_row_fn(bool c, int n3) {
 }
 
 }  // namespace
-
-bool set_cross_filter_isa(const std::string& name) {
-  const Isa best = best_isa();
-  Isa want = best;
-  if (name == "generic") want = Isa::Generic;
-  else if (name == "avx2") want = Isa::Avx2;
-  else if (name == "avx512") want = Isa::Avx512;
-  else if (!name.empty()) return false;
-  if (int(want) > int(best)) return false;  // the CPU lacks it
-  isa_choice().store(int(want), std::memory_order_relaxed);
-  return true;
-}
-
-const char* cross_filter_isa() {
-  switch (isa()) {
-    case Isa::Avx512: return "avx512";
-    case Isa::Avx2: return "avx2";
-    case Isa::Generic: break;
-  }
-  return "generic";
-}
 
 void cross_filter(const CrossPass& a, const Roi& region, int nthreads) {
   if (region.empty()) return;

@@ -1,4 +1,4 @@
-#include "filters/feature_regression.h"
+#include "kernels/feature_regression.h"
 
 // The kernel's L-lane vectors only live inside code inlined into functions compiled
 // for one instruction set (see feature_weights.cpp).
@@ -9,9 +9,9 @@
 #include <cmath>
 #include <cstring>
 
-#include "filters/simd_exp.h"
-#include "util/cpu_features.h"
+#include "kernels/simd_exp.h"
 #include "util/error.h"
+#include "util/isa.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -183,15 +183,14 @@ void rows_generic(const RegressionPass& a, const Channel* ch, int y, int x0, int
   for (int x = x0; x < x1; x += kLanes) fit_group<N, kLanes>(a, ch, x, std::min(kLanes, x1 - x), y);
 }
 template <int N>
-__attribute__((target("avx2"), flatten)) void rows_avx2(const RegressionPass& a, const Channel* ch, int y, int x0,
+MCR_TARGET_AVX2 __attribute__((flatten)) void rows_avx2(const RegressionPass& a, const Channel* ch, int y, int x0,
                                                         int x1) {
   for (int x = x0; x < x1; x += kLanes) fit_group<N, kLanes>(a, ch, x, std::min(kLanes, x1 - x), y);
 }
 
 template <int N>
 void fit_rows(const RegressionPass& a, const Channel* ch, const Roi& region, int nthreads) {
-  // The AVX2 build unless the cross kernel is held to the generic one (tests).
-  const bool avx2 = cpu_has_avx2() && std::strcmp(cross_filter_isa(), "generic") != 0;
+  const bool avx2 = isa_at_least(Isa::Avx2);
   parallel_rows(region.y0, region.y1, nthreads, [&](int y) {
     if (avx2) rows_avx2<N>(a, ch, y, region.x0, region.x1);
     else rows_generic<N>(a, ch, y, region.x0, region.x1);

@@ -1,10 +1,11 @@
-#include "filters/gaussian.h"
+#include "filters/image/gaussian.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "filters/feature_weights.h"
-#include "filters/foveation.h"
+#include "kernels/cross_bilateral.h"
+#include "kernels/foveation.h"
+#include "util/isa.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -13,14 +14,12 @@ namespace {
 
 // d[i] += g s[i]: the inner loop of both 1D passes, also built for the wider
 // vector units. No FMA contraction, so that every element rounds the same way
-// whichever clone runs and wherever the vector loop's peel and tail fall (a
+// whichever build runs and wherever the vector loop's peel and tail fall (a
 // region then gives exactly the pixels of the whole frame).
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
-__attribute__((target_clones("avx512f", "avx2", "default"), optimize("fp-contract=off")))
-#endif
-void madd(float* __restrict d, const float* __restrict s, float g, int n) {
+MCR_ALWAYS_INLINE void madd_body(float* __restrict d, const float* __restrict s, float g, int n) {
   for (int i = 0; i < n; ++i) d[i] += g * s[i];
 }
+MCR_ISA_VERSIONS(void, madd, (float* __restrict d, const float* __restrict s, float g, int n), (d, s, g, n))
 
 }  // namespace
 

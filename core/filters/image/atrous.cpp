@@ -1,11 +1,11 @@
-#include "filters/atrous.h"
+#include "filters/image/atrous.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "filters/feature_weights.h"
-#include "filters/foveation.h"
-#include "filters/noise_weight.h"
+#include "kernels/cross_bilateral.h"
+#include "kernels/foveation.h"
+#include "kernels/noise_relative_colour.h"
 #include "util/error.h"
 #include "util/parallel.h"
 

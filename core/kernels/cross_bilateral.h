@@ -12,7 +12,7 @@
 // 2e-7 relative that returns exactly 1 for 0 and exactly 0 for exponents beyond
 // -86 (and for NaN or infinite ones, so an overflowing feature difference gives
 // weight 0, never NaN). 4, 8 or 16 pixels are processed at once (GCC vector
-// extensions), with AVX-512 or AVX2+FMA chosen at run time, SSE2 otherwise.
+// extensions), with AVX-512 or AVX2+FMA chosen at run time (util/isa.h), SSE2 otherwise.
 //
 // Features and their on/off convention (the help text of every use_<f>):
 //   use_<f> = auto  used when the frame has the pass; when it has not, the weight is
@@ -28,8 +28,8 @@
 #include <string>
 #include <vector>
 
-#include "filters/foveation.h"
-#include "filters/params.h"
+#include "kernels/foveation.h"
+#include "util/params.h"
 #include "image/pass.h"
 
 namespace mcr {
@@ -159,12 +159,8 @@ struct CrossPass {
 // the same result, with half the exponentials.
 void cross_filter(const CrossPass& pass, const Roi& region, int nthreads);
 
-// The instruction set cross_filter() runs on: "avx512" (16 lanes), "avx2" (8 lanes,
-// FMA) or "generic" (4 lanes, SSE2 on x86-64); the best the CPU has unless set.
-const char* cross_filter_isa();
-// Chooses it for later calls ("" = the best the CPU has); false, and nothing
-// changed, for a name the CPU cannot run. For tests and benchmarks.
-bool set_cross_filter_isa(const std::string& name);
+// The instruction set is util/isa.h's isa(): avx512 (16 lanes, FMA), avx2 (8 lanes, FMA)
+// or generic (4 lanes, SSE2 on x86-64); results agree within FMA rounding.
 
 // exp(-e) as the kernel computes it (for tests): exact 1 at 0, 0 for e >= 86 or NaN.
 float fast_exp_neg(float e);

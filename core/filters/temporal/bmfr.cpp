@@ -1,4 +1,4 @@
-#include "filters/bmfr.h"
+#include "filters/temporal/bmfr.h"
 
 #include <algorithm>
 #include <chrono>
@@ -10,7 +10,7 @@
 #include "util/avx2_shuffles.h"
 #include "util/error.h"
 #include "util/parallel.h"
-#include "util/cpu_features.h"
+#include "util/isa.h"
 
 namespace mcr {
 
@@ -209,7 +209,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       if (ach == 3) {  // the usual RGB albedo: one flat, vectorisable loop
         std::size_t j0 = b * 3;
 #ifdef MCR_BMFR_AVX2
-        if (cpu_has_avx2()) j0 += demodulate_avx2(ad + j0, co + j0, lo, (e - b) * 3, al + j0, il + j0);
+        if (isa_at_least(Isa::Avx2)) j0 += demodulate_avx2(ad + j0, co + j0, lo, (e - b) * 3, al + j0, il + j0);
 #endif
         for (std::size_t j = j0; j < e * 3; ++j) {
           const float v = ad[j];
@@ -270,7 +270,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     constexpr float M = std::numeric_limits<float>::max();
     int x0 = 0;
 #ifdef MCR_BMFR_AVX2
-    if (cpu_has_avx2()) x0 = remodulate_row_avx2(s, a, w, r0, r1, r2);
+    if (isa_at_least(Isa::Avx2)) x0 = remodulate_row_avx2(s, a, w, r0, r1, r2);
 #endif
     // Infinities become +-max, NaN stays (std::min/max keep their first argument).
     if (a)

@@ -1,4 +1,4 @@
-#include "filters/fireflies.h"
+#include "prepare/fireflies.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,9 +1,9 @@
-#include "filters/albedo_prefilter.h"
+#include "prepare/albedo_prefilter.h"
 
 #include <algorithm>
 #include <cmath>
 
-#include "filters/bilateral.h"
+#include "filters/image/bilateral.h"
 #include "util/parallel.h"
 
 namespace mcr {

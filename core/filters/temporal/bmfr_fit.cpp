@@ -6,7 +6,7 @@
 #include <cmath>
 #include <limits>
 
-#include "filters/bmfr.h"
+#include "filters/temporal/bmfr.h"
 #include "linalg/householder_qr.h"
 #include "util/parallel.h"
 
@@ -15,7 +15,7 @@
 #include <emmintrin.h>
 #endif
 #include "util/avx2_shuffles.h"
-#include "util/cpu_features.h"
+#include "util/isa.h"
 
 namespace mcr {
 
@@ -156,11 +156,6 @@ void scale_masked(const float* src, const float* mask, int np, float lo, float s
   }
 }
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__) && defined(__linux__)
-#define MCR_FIT_CLONES __attribute__((target_clones("avx2", "default")))
-#else
-#define MCR_FIT_CLONES
-#endif
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #define MCR_FIT_GATHER_AVX2 1
@@ -228,10 +223,9 @@ struct FitJob {
   Image* fitted;
 };
 
-// Fits block b. Built for AVX2 as well (picked at load time): no FMA, so the same
-// operations and the same results as the baseline build.
-MCR_FIT_CLONES
-void fit_block(const FitJob& J, FitScratch& S, int b) {
+// Fits block b. Built for AVX2 as well (util/isa.h): no FMA, so the same operations and
+// the same results as the generic build.
+MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
   const int w = J.w, h = J.h, B = J.B, ox = J.ox, oy = J.oy, nbx = J.nbx, R = J.R, M = J.M, pch = J.pch, nch = J.nch;
   const FeatureLayout& lay = J.lay;
   const double eps = J.eps;
@@ -266,7 +260,7 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
     const float* vrow = valid + rb;
     int x = 0;
 #ifdef MCR_FIT_GATHER_AVX2
-    if (!alb && !dep && pch == 3 && nch == 3 && cpu_has_avx2()) {
+    if (!alb && !dep && pch == 3 && nch == 3 && isa_at_least(Isa::Avx2)) {
       x = bw / 8 * 8;
       W = gather_row_avx2(nrow, prow, irow, vrow, x, p, snp, raw, fin, zp, rows, W);
       p += x;
@@ -494,6 +488,7 @@ void fit_block(const FitJob& J, FitScratch& S, int b) {
       }
   }
 }
+MCR_ISA_VERSIONS_AVX2(void, fit_block, (const FitJob& J, FitScratch& S, int b), (J, S, b))
 
 }  // namespace
 

@@ -22,7 +22,7 @@
 #include <string>
 #include <vector>
 
-#include "filters/params.h"
+#include "util/params.h"
 #include "image/image.h"
 
 namespace mcr {

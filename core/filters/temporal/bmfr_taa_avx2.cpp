@@ -1,9 +1,9 @@
-#include "filters/bmfr_taa_avx2.h"
+#include "filters/temporal/bmfr_taa_avx2.h"
 
 #include <limits>
 
-#include "filters/bmfr_taa_cr.h"
-#include "util/cpu_features.h"
+#include "filters/temporal/bmfr_taa_cr.h"
+#include "util/isa.h"
 
 #if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
 #include <immintrin.h>
@@ -36,7 +36,7 @@ MCR_AVX2 void col8(__m256 v0, __m256 v1, __m256 v2, float* s, float* q, float* m
 
 }  // namespace
 
-bool taa_avx2_available() { return cpu_has_avx2(); }
+bool taa_avx2_available() { return isa_at_least(Isa::Avx2); }
 
 __attribute__((target("avx2"))) int taa_stats_avx2(int x, int w, bool ycocg, const float* R, const float* G,
                                                    const float* Bc, std::size_t r0, std::size_t r1, std::size_t r2,

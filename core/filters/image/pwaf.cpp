@@ -1,4 +1,4 @@
-#include "filters/pwaf.h"
+#include "filters/image/pwaf.h"
 
 #include <algorithm>
 #include <chrono>
