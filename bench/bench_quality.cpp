@@ -1,6 +1,6 @@
 // Run time against error on the sample scenes: every registered filter, a sweep
-// of its main parameter (FilterInfo::sweep_param), with and without albedo
-// demodulation, under the defaults, firefly_k=2, firefly_k=1 and the filter's sweep_variants,
+// of its main parameter (bench/sweeps.cpp), with and without albedo
+// demodulation, under the defaults, firefly_k=2, firefly_k=1 and the filter's own variants,
 // against the noisy input and the same scene at 4x the samples.
 //   mcrecon_bench_quality [--spp 16] [--scenes room,glossy] [--filters a,b] [--threads N] [--json FILE]
 #include <cstdio>
@@ -17,6 +17,7 @@
 #include "filters/registry.h"
 #include "io/sample_manifest.h"
 #include "pipeline/evaluate.h"
+#include "sweeps.h"
 #include "util/error.h"
 
 namespace {
@@ -77,13 +78,13 @@ int main(int argc, char** argv) {
         if (!wanted(filters_wanted, name)) continue;
         const mcr::FilterInfo& info = mcr::filter_info(name);
         if (info.temporal) continue;  // sequences have their own benchmark
-        std::vector<double> values = info.sweep_values;
-        if (values.empty() || info.sweep_param.empty()) values = {std::nan("")};
+        const mcr::bench::Sweep& sweep = mcr::bench::sweep_for(name);
+        std::vector<double> values = sweep.values;
+        if (values.empty() || sweep.param.empty()) values = {std::nan("")};
         Best best{"", {}};
         best.ev.metrics.relmse = 1e300;
         // Variants: the defaults, firefly suppression (a common parameter), the filter's own.
-        std::vector<std::string> variants = {"", "firefly_k=2", "firefly_k=1"};
-        for (const std::string& v : info.sweep_variants) variants.push_back(v);
+        const std::vector<std::string> variants = mcr::bench::sweep_variants(name);
         for (const std::string& variant : variants)
         for (bool demod : {false, true}) {
           if (demod && !loaded.frames.front().has(mcr::Role::Albedo)) continue;
@@ -99,12 +100,13 @@ int main(int argc, char** argv) {
               }
             }
             if (!std::isnan(v)) {
-              filter->set(info.sweep_param, v);
-              setting += info.sweep_param + "=" + mcr::param_value_text(filter->params().values().at(info.sweep_param));
+              filter->set(sweep.param, v);
+              setting += sweep.param + "=" + mcr::param_value_text(filter->params().values().at(sweep.param));
             } else {
               setting += "defaults";
             }
-            filter->set("demodulate", demod);
+            if (demod && !filter->params().has("demodulate")) break;
+            if (demod) filter->set("demodulate", true);
             filter->commit();
             if (!filter->missing_passes(loaded.frames.front()).empty()) break;
             // Best of 3 runs for the time; the error is deterministic.

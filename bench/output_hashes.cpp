@@ -130,7 +130,8 @@ int main(int argc, char** argv) {
                 setting += (setting.empty() ? "" : " ") + sweep.param + "=" +
                            mcr::param_value_text(filter->params().values().at(sweep.param));
               }
-              filter->set("demodulate", demod);
+              if (demod && !filter->params().has("demodulate")) break;  // bmfr demodulates itself
+              if (demod) filter->set("demodulate", true);
               filter->commit();
               if (!filter->missing_passes(loaded.frames.front()).empty()) break;
               if (setting.empty()) setting = "defaults";

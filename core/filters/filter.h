@@ -1,14 +1,18 @@
 #pragma once
 // Filter interface (set -> commit -> execute), after OIDN's filter lifecycle.
 // Parameters live in a ParamSet built from the filter's one table; every input
-// check happens in commit() (parameters) and execute() (passes), nowhere else.
-#include <algorithm>
+// check happens in commit() (parameters) and execute() (passes, before any work).
+//
+// execute() = the preparation steps the filter takes (prepare/preparation.h: holes,
+// albedo prefilter, demodulation, outliers) -> run() -> finish (remodulation; outside
+// the roi the input colour; nothing non-finite leaves).
 #include <memory>
 #include <string>
 #include <vector>
 
-#include "util/params.h"
 #include "image/pass.h"
+#include "prepare/preparation.h"
+#include "util/params.h"
 
 namespace mcr {
 
@@ -17,36 +21,24 @@ struct FilterInfo {
   std::string summary;  // one line
   std::string reference;  // paper / section it implements
   ParamTable params;
-  std::vector<Role> required;  // passes it cannot run without
-  std::vector<Role> optional;  // passes it uses when present
+  std::vector<Role> required;  // passes it cannot run without (under any setting)
+  std::vector<Role> optional;  // passes it may use when present (under some setting)
+  PrepSteps steps;             // the preparation steps it takes (their parameters end its table)
   bool temporal = false;       // keeps history between execute() calls (frame order matters)
   std::string nonfinite_policy;  // what it does with NaN/Inf input, for docs and `filters`
-  // The main parameter and the values the run-time-against-error benchmark sweeps.
-  std::string sweep_param;
-  std::vector<double> sweep_values;
-  // Further settings ("key=value key=value") the benchmark sweeps the main parameter under,
-  // besides the defaults and firefly_k=2 (which every filter gets).
-  std::vector<std::string> sweep_variants;
 };
 
-// Parameters every filter's table ends with; the base class applies them
-// around run(), so each filter gets them for free:
-//   demodulate   divide the colour by the albedo pass before filtering, multiply after
-//   albedo_floor albedo is raised to at least albedo_floor for that (Blender's albedo
-//                reaches ~0.03 on glossy metal); no upper clamp: it exceeds 1 on
-//                highlights (>100 near lights) and dividing and multiplying by the same
-//                value is exact (a ceiling of 1 cost 8% relMSE on the glossy scene)
-//   holes        pixels the render did not sample, filled by pull-push (features too)
-//                before filtering: auto (sample_count == 0 when that pass exists),
-//                none, sample_count, alpha (alpha == 0)
-//   firefly_k, firefly_radius  bright outliers clamped to their window's
-//                statistics before filtering (filters/fireflies.h); 0 = off
+// `own` followed by the parameters of every preparation step (what most filters take).
 ParamTable with_common_params(ParamTable own);
 
-// The albedo that demodulation divides by and remodulation multiplies by: at least
-// albedo_floor, 1 where the pass is not finite (one rule for every filter and pwaf's
-// variance scaling).
-inline float demodulation_albedo(float v, float floor) { return (v - v == 0.0f) ? std::max(v, floor) : 1.0f; }
+// The passes a filter needs and uses under its current settings.
+struct PassNeeds {
+  std::vector<Role> required;  // execute() fails without them
+  std::vector<Role> optional;  // used when present
+  std::vector<std::string> why;  // per required pass: the setting that needs it ("" = always)
+  void require(Role r, const std::string& setting = "");
+  void use(Role r);
+};
 
 struct ExecOptions {
   Roi roi;           // empty = whole frame; pixels outside keep the input colour
@@ -67,15 +59,21 @@ class Filter {
   void commit();
 
   // Runs on one frame and returns its RGB result (same size as the frame).
-  // Throws MissingPass naming the passes the frame lacks.
+  // Throws MissingPass naming the passes the frame lacks, before any work.
   Image execute(const Frame& frame, const ExecOptions& options = {});
 
   // Drops temporal history (new shot, frames out of order).
   virtual void reset() {}
 
-  // Passes in info().required that the frame lacks.
+  // What the current settings read: the filter's own needs plus its preparation steps'.
+  PassNeeds needs() const;
+  // Passes in needs().required that the frame lacks.
   std::vector<Role> missing_passes(const Frame& frame) const;
-  // Notes from the last execute(), e.g. which optional weights were dropped.
+  // Settings given that change nothing under the others (from commit()), e.g.
+  // "firefly_radius has no effect with firefly_k=0".
+  const std::vector<std::string>& unused_settings() const { return unused_; }
+  // Notes from the last execute() (which optional weights were dropped, ...), after the
+  // unused-setting notes.
   const std::vector<std::string>& notes() const { return notes_; }
   // Non-finite values the safety net replaced in the last execute(); a correct
   // filter keeps this at 0 (tests check it).
@@ -83,22 +81,38 @@ class Filter {
 
  protected:
   virtual void check_params() {}
-  // colour: the RGB input to filter (holes filled, demodulated when asked); read it,
-  // not frame's colour pass. frame: every pass (holes filled too). out arrives as a
+  // The filter's own needs under params_ (default: info().required / optional).
+  virtual PassNeeds own_needs() const;
+  // Settings of its own table that have no effect under params_ (check_params() time).
+  virtual std::vector<std::string> own_unused() const { return {}; }
+  // The pixels run() reads to write roi (the preparation steps work there): default the
+  // whole frame.
+  virtual Roi reads(const Roi& roi, int width, int height) const {
+    (void)roi;
+    return Roi::all(width, height);
+  }
+  // colour: the RGB input to filter (after the preparation steps); read it, not frame's
+  // colour pass. frame: every pass (holes filled, albedo prefiltered). out arrives as a
   // copy of colour; write the result inside roi.
   virtual void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) = 0;
   // True when run() reads `colour` only before it writes any pixel of `out` and writes
   // every pixel of the roi: the base class then passes the colour buffer itself as `out`
-  // (the same object: no copy of the frame; pixels outside the roi keep the input).
+  // (the same object: no copy of the frame).
   virtual bool run_in_place() const { return false; }
+  // During run(): the demodulation divisor (RGB, valid inside the roi), null when the
+  // colour was not demodulated.
+  const Image* demodulation_divisor() const { return prepared_.divisor.empty() ? nullptr : &prepared_.divisor; }
   void note(std::string text) { notes_.push_back(std::move(text)); }
+  // "<name> has no effect <why>" when the setting was given (for own_unused()).
+  void unused_when(bool no_effect, const std::string& name, const std::string& why, std::vector<std::string>& out) const;
 
   ParamSet params_;
 
  private:
   const FilterInfo& info_;
   bool committed_ = false;
-  std::vector<std::string> notes_;
+  Prepared prepared_;
+  std::vector<std::string> unused_, notes_;
   std::size_t repaired_ = 0;
 };
 

@@ -13,6 +13,9 @@ struct Roi {
   bool empty() const { return x1 <= x0 || y1 <= y0; }
   static Roi all(int w, int h) { return {0, 0, w, h}; }
   Roi clipped(int w, int h) const;  // intersection with the image
+  // Grown by `by` pixels on every side, clipped to a w x h image.
+  Roi grown(int by, int w, int h) const { return Roi{x0 - by, y0 - by, x1 + by, y1 + by}.clipped(w, h); }
+  bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
   bool operator==(const Roi& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
 };
 

@@ -15,7 +15,7 @@
 #include <type_traits>
 #include <utility>
 
-#include "kernels/simd_exp.h"
+#include "kernels/fast_exp.h"
 #include "util/error.h"
 #include "util/isa.h"
 #include "util/parallel.h"
@@ -83,10 +83,6 @@ std::vector<std::string> feature_sigma_names() {
   std::vector<std::string> names;
   for (Feature f : kFeatures) names.push_back(std::string(feature_name(f)) + "_sigma");
   return names;
-}
-
-Roi grow_roi(const Roi& roi, int reach, int w, int h) {
-  return Roi{roi.x0 - reach, roi.y0 - reach, roi.x1 + reach, roi.y1 + reach}.clipped(w, h);
 }
 
 std::vector<float> PlaneBox::plane(float fill) const {

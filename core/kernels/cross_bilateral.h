@@ -24,6 +24,7 @@
 //                   depth: scene units; albedo: reflectance)
 // Normals are Blender's filtered camera-space Denoising Normal (Prefer::Feature),
 // positions world space, depth its first channel.
+#include <cmath>
 #include <functional>
 #include <string>
 #include <vector>
@@ -48,8 +49,6 @@ ParamTable feature_params(const FeatureDefaults& defaults = {});
 // {"colour_sigma", "normal_sigma", ...}: the names to pass to with_foveation().
 std::vector<std::string> feature_sigma_names();
 
-// roi grown by `reach` pixels on every side, clipped to a w x h image.
-Roi grow_roi(const Roi& roi, int reach, int w, int h);
 
 // Layout of every plane of one execute(): the pixels of `box` (absolute image
 // coordinates), row-major, each row padded by kPlanePad zero columns on both
@@ -115,6 +114,9 @@ struct Guides {
 // Fills `g`, reusing the memory it holds from an earlier call.
 void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& fov, const std::string& filter,
                    const PlaneBox& pb, const std::function<void(std::string)>& note, int nthreads, Guides& g);
+
+// Half width of a Gaussian window of standard deviation sigma: ceil(3 sigma), 0 for sigma 0.
+inline int gaussian_radius(double sigma) { return sigma > 0 ? int(std::ceil(3.0 * sigma - 1e-6)) : 0; }
 
 // One pass of the weighted sum. Every pointer is a plane laid out by `pb`; a null
 // plane means the matching constant.

@@ -9,7 +9,7 @@
 #include <cmath>
 #include <cstring>
 
-#include "kernels/simd_exp.h"
+#include "kernels/fast_exp.h"
 #include "util/error.h"
 #include "util/isa.h"
 #include "util/parallel.h"

@@ -4,7 +4,8 @@
 #include <cmath>
 #include <cstdint>
 
-#include "filters/image/pwaf.h"
+#include "image/luminance.h"
+#include "kernels/noise_variance.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -22,16 +23,16 @@ std::vector<double> noise_variance(const Image& colour, const Image* sample_coun
   if (box.empty()) return out;
   // The 3x3 smoothing reads one pixel beyond the box; the estimate's own 3x3 window is
   // handled inside estimate_variance (it reads what it needs around its region).
-  const Roi er = grow_roi(box, 1, w, h);
+  const Roi er = box.grown(1, w, h);
   std::vector<std::uint8_t> valid(std::size_t(w) * std::size_t(h), 1);
-  const Roi vr = grow_roi(er, 2, w, h);
+  const Roi vr = er.grown(2, w, h);
   parallel_rows(vr.y0, vr.y1, nthreads, [&](int y) {
     for (int x = vr.x0; x < vr.x1; ++x) {
       const float* p = colour.pixel(x, y);
-      valid[std::size_t(y) * w + x] = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+      valid[std::size_t(y) * w + x] = finite3(p);
     }
   });
-  const std::vector<double> v = pwaf::estimate_variance(colour, valid, sample_count, 1, er, nthreads);
+  const std::vector<double> v = estimate_variance(colour, valid, sample_count, 1, er, nthreads);
   static constexpr double kb[3] = {0.25, 0.5, 0.25};
   parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
     for (int x = box.x0; x < box.x1; ++x) {
@@ -48,7 +49,7 @@ std::vector<double> noise_variance(const Image& colour, const Image* sample_coun
         }
       const float* p = colour.pixel(x, y);
       const bool finite = std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
-      const double yl = finite ? 0.2126 * double(p[0]) + 0.7152 * double(p[1]) + 0.0722 * double(p[2]) : 0.0;
+      const double yl = finite ? luminance(p) : 0.0;
       const double gv = sw > 0 ? s / sw : 0.0;
       out[std::size_t(y - box.y0) * std::size_t(box.width()) + std::size_t(x - box.x0)] =
           std::min(3.0 * gv + 1e-6 * yl * yl + 1e-30, 1e300);

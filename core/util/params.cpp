@@ -140,6 +140,7 @@ void ParamSet::set(const std::string& name, const ParamValue& value) {
     }
   }
   values_[name] = v;
+  given_.insert(name);
 }
 
 void ParamSet::set_text(const std::string& name, const std::string& text) {

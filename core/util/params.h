@@ -3,6 +3,7 @@
 // the OIIO plugin, the Python module and the Blender UI are all generated from it.
 #include <cstdint>
 #include <map>
+#include <set>
 #include <string>
 #include <variant>
 #include <vector>
@@ -40,6 +41,8 @@ class ParamSet {
   void set(const std::string& name, const ParamValue& value);
   void set_text(const std::string& name, const std::string& text);  // parses by the spec's type
   bool has(const std::string& name) const;
+  // True when a setter gave this parameter a value (for the unused-setting report).
+  bool was_set(const std::string& name) const { return given_.count(name) != 0; }
 
   std::int64_t get_int(const std::string& name) const;
   double get_float(const std::string& name) const;
@@ -52,6 +55,7 @@ class ParamSet {
   std::string owner_;
   const ParamTable* table_ = nullptr;
   std::map<std::string, ParamValue> values_;
+  std::set<std::string> given_;
 };
 
 std::string param_value_text(const ParamValue& v);  // "5", "0.25", "true", "gaussian"

@@ -36,7 +36,7 @@ Frame checker_frame(int w, int h, float lo, float hi) {
 TEST(AlbedoPrefilter, CleanTextureEdgesAreKept) {
   const Frame f = checker_frame(24, 16, 0.1f, 0.8f);
   const Pass& a = *f.find(Role::Albedo);
-  const Image out = prefilter_albedo(f, a, AlbedoPrefilter{}, 0);
+  const Image out = prefilter_albedo(f, a, AlbedoPrefilter{}, Roi::all(f.width, f.height), 0);
   for (std::size_t i = 0; i < out.storage().size(); ++i)
     ASSERT_NEAR(out.storage()[i], a.image.storage()[i], 1e-5 * a.image.storage()[i]) << "value " << i;
 }
@@ -47,7 +47,7 @@ TEST(AlbedoPrefilter, MultiplicativeNoiseOnAFlatAlbedoShrinks) {
   std::mt19937 rng(4);
   std::normal_distribution<float> n(0.0f, 0.03f);
   for (float& v : a.storage()) v *= std::exp(n(rng));
-  const Image out = prefilter_albedo(f, *f.find(Role::Albedo), AlbedoPrefilter{}, 0);
+  const Image out = prefilter_albedo(f, *f.find(Role::Albedo), AlbedoPrefilter{}, Roi::all(f.width, f.height), 0);
   auto log_var = [](const Image& im) {
     double s = 0, s2 = 0;
     for (float v : im.storage()) s += std::log(v), s2 += std::log(v) * std::log(v);
@@ -62,7 +62,7 @@ TEST(AlbedoPrefilter, NonFiniteAlbedoKeepsItsValue) {
   Image& a = pass_image(f, Role::Albedo);
   a.at(3, 3, 1) = kNaN;
   a.at(7, 5, 0) = kInf;
-  const Image out = prefilter_albedo(f, *f.find(Role::Albedo), AlbedoPrefilter{}, 0);
+  const Image out = prefilter_albedo(f, *f.find(Role::Albedo), AlbedoPrefilter{}, Roi::all(f.width, f.height), 0);
   EXPECT_TRUE(std::isnan(out.at(3, 3, 1)));
   EXPECT_EQ(out.at(7, 5, 0), kInf);
   for (int y = 0; y < 10; ++y)
@@ -81,7 +81,7 @@ TEST(AlbedoPrefilter, DemodulationUsesTheSmoothedAlbedo) {
   for (float& v : a.storage()) v *= u(rng);
   Image& c = pass_image(f, Role::Colour);
   for (std::size_t i = 0; i < c.storage().size(); ++i) c.storage()[i] = 2.0f * a.storage()[i];
-  const Image smooth = prefilter_albedo(f, *f.find(Role::Albedo), AlbedoPrefilter{}, 0);
+  const Image smooth = prefilter_albedo(f, *f.find(Role::Albedo), AlbedoPrefilter{}, Roi::all(f.width, f.height), 0);
   BoxFilter box;
   box.set("radius", std::int64_t(20));
   box.set("demodulate", true);
@@ -109,7 +109,7 @@ TEST(AlbedoPrefilter, EveryFilterStaysFiniteWithIt) {
     pass_image(f, Role::Position).at(6, 6, 1) = kInf;
     auto filter = make_filter(name);
     filter->set("albedo_prefilter", 0.2);
-    filter->set("demodulate", true);
+    filter->set(filter->params().has("demodulate") ? "demodulate" : "albedo_demodulation", true);
     filter->commit();
     const Image out = filter->execute(f);
     for (float v : out.storage()) ASSERT_TRUE(std::isfinite(v)) << name;

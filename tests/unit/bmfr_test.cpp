@@ -78,8 +78,10 @@ double max_rel_error(const Image& got, const Image& want) {
 TEST(Bmfr, RegisteredWithItsTable) {
   const FilterInfo& info = filter_info("bmfr");
   EXPECT_TRUE(info.temporal);
-  EXPECT_EQ(info.sweep_param, "block_size");
-  EXPECT_EQ(info.sweep_values, (std::vector<double>{16, 32, 64}));
+  // Its own demodulation: the common step is not among its parameters.
+  EXPECT_FALSE(info.steps.demodulate);
+  EXPECT_TRUE(make_filter("bmfr")->params().has("albedo_floor"));
+  EXPECT_FALSE(make_filter("bmfr")->params().has("demodulate"));
   EXPECT_FALSE(info.nonfinite_policy.empty());
 }
 
@@ -121,9 +123,10 @@ TEST(Bmfr, DemodulatesByAlbedo) {
   EXPECT_GT(max_rel_error(g->execute(frame_of(s)), s.colour), 1e-2);
 }
 
-TEST(Bmfr, CommonDemodulateDividesOnlyOnce) {
-  // demodulate=true (base class, around the whole pipeline) replaces albedo_demodulation:
-  // dividing twice would leave albedo^-1 in the fit and break the exact reproduction.
+TEST(Bmfr, OwnDemodulationReproducesATexturedLinearScene) {
+  // bmfr divides by the albedo itself (albedo_demodulation, fused into phase I) and
+  // multiplies back before TAA: illumination affine in the features times a checker
+  // albedo is reproduced; without demodulation the checker breaks the affine model.
   Scene s = linear_scene(40, 40);
   for (int y = 0; y < 40; ++y)
     for (int x = 0; x < 40; ++x)
@@ -132,8 +135,10 @@ TEST(Bmfr, CommonDemodulateDividesOnlyOnce) {
         s.albedo.pixel(x, y)[c] = a;
         s.colour.pixel(x, y)[c] *= a;
       }
-  auto f = make_bmfr({{"epsilon", 0.0}, {"demodulate", true}});
+  auto f = make_bmfr({{"epsilon", 0.0}});
   EXPECT_LT(max_rel_error(f->execute(frame_of(s)), s.colour), 1e-4);
+  auto plain = make_bmfr({{"epsilon", 0.0}, {"albedo_demodulation", false}});
+  EXPECT_GT(max_rel_error(plain->execute(frame_of(s)), s.colour), 1e-2);
 }
 
 TEST(Bmfr, MissingFeaturePassIsAnError) {

@@ -119,7 +119,7 @@ TEST(FilterStress, ZeroAlbedoWithDemodulation) {
     Frame f = full_frame(18, 13, 6);
     for (float& v : pass_of(f, Role::Albedo).image.storage()) v = 0.0f;
     auto filter = make_filter(name);
-    filter->set("demodulate", true);
+    filter->set(filter->params().has("demodulate") ? "demodulate" : "albedo_demodulation", true);
     filter->commit();
     expect_clean(name, *filter, f, "zero albedo, demodulate");
   }

@@ -93,11 +93,11 @@ TEST(GaussianFilterTest, SigmaZeroIsIdentity) {
 }
 
 TEST(GaussianFilterTest, RadiusIsCeilThreeSigma) {
-  EXPECT_EQ(GaussianFilter::radius_for(0.0), 0);
-  EXPECT_EQ(GaussianFilter::radius_for(0.1), 1);
-  EXPECT_EQ(GaussianFilter::radius_for(1.0), 3);
-  EXPECT_EQ(GaussianFilter::radius_for(8.0 / 3.0), 8);
-  EXPECT_EQ(GaussianFilter::radius_for(21.0), 63);
+  EXPECT_EQ(gaussian_radius(0.0), 0);
+  EXPECT_EQ(gaussian_radius(0.1), 1);
+  EXPECT_EQ(gaussian_radius(1.0), 3);
+  EXPECT_EQ(gaussian_radius(8.0 / 3.0), 8);
+  EXPECT_EQ(gaussian_radius(21.0), 63);
   // A single bright pixel spreads exactly ceil(3 sigma) pixels, no further.
   Image in(31, 1, 3, 0.0f);
   in.at(15, 0, 0) = 1.0f;

@@ -14,6 +14,8 @@
 
 #include "filters/registry.h"
 #include "util/error.h"
+#include "kernels/noise_variance.h"
+#include "prepare/outliers.h"
 
 namespace mcr {
 namespace {
@@ -156,7 +158,7 @@ TEST(PwafVarianceTest, RecoversKnownVarianceOfNoiseOnFlatAndLinearSignals) {
         for (int c = 0; c < 3; ++c)
           im.at(x, y, c) = float((ramp ? 0.2 + 0.01 * x + 0.005 * y : 0.5) + g(rng));
     const std::vector<std::uint8_t> valid(std::size_t(w) * h, 1);
-    const std::vector<double> v = pwaf::estimate_variance(im, valid, nullptr, 3, Roi::all(w, h), 2);
+    const std::vector<double> v = estimate_variance(im, valid, nullptr, 3, Roi::all(w, h), 2);
     const std::vector<double> in = interior(v, w, h, 4);
     double mean = 0;
     for (double x : in) mean += x;
@@ -186,7 +188,7 @@ TEST(PwafVarianceTest, SampleCountDividesThePerSampleVariance) {
       for (int c = 0; c < 3; ++c) im.at(x, y, c) = float(0.5 + g(rng) * s / std::sqrt(spp));
     }
   const std::vector<std::uint8_t> valid(std::size_t(w) * h, 1);
-  const std::vector<double> v = pwaf::estimate_variance(im, valid, &n, 3, Roi::all(w, h), 1);
+  const std::vector<double> v = estimate_variance(im, valid, &n, 3, Roi::all(w, h), 1);
   std::vector<double> left, right, left_edge, right_edge;
   for (int y = 4; y < h - 4; ++y) {
     for (int x = 4; x < w / 2 - 4; ++x) left.push_back(v[std::size_t(y) * w + x]);
@@ -199,7 +201,7 @@ TEST(PwafVarianceTest, SampleCountDividesThePerSampleVariance) {
   EXPECT_NEAR(median(left_edge), 0.04, 0.15 * 0.04);
   EXPECT_NEAR(median(right_edge), 0.01, 0.15 * 0.01);
   // Without the sample counts both sides get one (mixed) level near the boundary: the pass matters.
-  const std::vector<double> plain = pwaf::estimate_variance(im, valid, nullptr, 3, Roi::all(w, h), 1);
+  const std::vector<double> plain = estimate_variance(im, valid, nullptr, 3, Roi::all(w, h), 1);
   EXPECT_GT(plain[std::size_t(h / 2) * w + w / 2] / v[std::size_t(h / 2) * w + w / 2], 1.5);
 }
 
@@ -290,7 +292,7 @@ TEST(PwafOutlierTest, PlantedFireflyIsReplacedByNeighbourhoodMeanAndNothingElseC
   Image im = random_image(w, h, 11, 0.45f, 0.55f);
   const int fx = 9, fy = 7;
   for (int c = 0; c < 3; ++c) im.at(fx, fy, c) = 1e4f;
-  const pwaf::OutlierResult r = pwaf::suppress_outliers(im, 3, 5.0, Roi::all(w, h), 2);
+  const OutlierResult r = replace_outliers(im, 3, 5.0, Roi::all(w, h), 2);
   double want[3] = {0, 0, 0};
   int n = 0;
   for (int y = fy - 3; y <= fy + 3; ++y)
@@ -313,7 +315,7 @@ TEST(PwafOutlierTest, DisabledByKZeroButNonFiniteStillRepaired) {
   Image im = random_image(12, 12, 12, 0.45f, 0.55f);
   for (int c = 0; c < 3; ++c) im.at(3, 3, c) = 1e4f;
   im.at(8, 8, 1) = kNaN;
-  const pwaf::OutlierResult r = pwaf::suppress_outliers(im, 2, 0.0, Roi::all(12, 12), 1);
+  const OutlierResult r = replace_outliers(im, 2, 0.0, Roi::all(12, 12), 1);
   EXPECT_EQ(r.colour.at(3, 3, 0), 1e4f);
   EXPECT_EQ(r.replaced[8 * 12 + 8], 2);
   EXPECT_TRUE(std::isfinite(r.colour.at(8, 8, 1)));

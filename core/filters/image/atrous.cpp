@@ -27,9 +27,6 @@ ParamTable atrous_params() {
   t.push_back(ParamSpec::Float("colour_sigma_decay", 0.5, 0.05, 1.0,
                                "pass i uses colour_sigma * decay^(i-1): 0.5 halves it every pass as in Dammertz et al. "
                                "(sigma_rt 2^-i), 1 keeps it constant"));
-  t.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
-                               "firefly clamp: > 0 clamps every colour channel to [-clamp, clamp] before filtering; "
-                               "0 = off (the colour weight alone keeps fireflies from spreading)"));
   return with_common_params(with_foveation(t, feature_sigma_names()));
 }
 
@@ -60,15 +57,6 @@ const FilterInfo& AtrousFilter::static_info() {
         "neighbour in the next pass. Feature differences that overflow give weight 0 (never NaN); colour beyond "
         "[2^-20, 2^100] is scaled by an exact power of two while summing, so sums never overflow and tiny values "
         "keep their precision";
-    i.sweep_param = "iterations";
-    i.sweep_values = {1, 2, 3, 4, 5, 6};
-    // The second: tight position/colour stops with a 3-tap kernel, the best found on the
-    // glossy scene (0.00703 there against 0.00828 for the defaults' best).
-    i.sweep_variants = {"colour_weight=noise firefly_k=2",
-                        "kernel_size=3 colour_sigma=0.7 normal_sigma=0.5 position_sigma=0.08 albedo_sigma=0.5 "
-                        "use_depth=on firefly_k=1",
-                        "kernel_size=3 colour_sigma=0.7 normal_sigma=0.5 position_sigma=0.08 albedo_sigma=0.5 "
-                        "use_depth=on firefly_k=1 albedo_prefilter=0.2"};
     return i;
   }();
   return info;
@@ -93,10 +81,10 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
   // Pass i reaches half * 2^(i-1); pass i must cover roi grown by what the later passes reach.
   std::vector<int> grow(std::size_t(iterations) + 1, 0);  // grow[i] = reach of passes i+1..n
   for (int i = iterations - 1; i >= 0; --i) grow[std::size_t(i)] = std::min(1 << 20, grow[std::size_t(i) + 1] + half * (1 << i));
-  const Roi box = grow_roi(roi, grow[0], w, h);
+  const Roi box = roi.grown(grow[0], w, h);
 
   const Foveation fov(params_, w, h);
-  planar_colour(colour, box, params_.get_float("clamp"), nthreads, cp_);
+  planar_colour(colour, box, 0.0, nthreads, cp_);
   ColourPlanes& cp = cp_;
   const PlaneBox& pb = cp.pb;
   gather_guides(frame, params_, fov, info().name, pb, [this](std::string s) { note(std::move(s)); }, nthreads, guides_);
@@ -128,7 +116,7 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
   pass.valid_mask = guides.ok.data();
   for (int i = 1; i <= iterations; ++i) {
     const int step = 1 << (i - 1);
-    const Roi region = grow_roi(roi, grow[std::size_t(i)], w, h);
+    const Roi region = roi.grown(grow[std::size_t(i)], w, h);
     for (int c = 0; c < 3; ++c) {
       pass.colour[c] = cur[c].data();
       pass.out[c] = nxt[c].data();

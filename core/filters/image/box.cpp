@@ -18,8 +18,6 @@ const FilterInfo& BoxFilter::static_info() {
     i.required = {Role::Colour};
     i.nonfinite_policy =
         "a pixel with any non-finite RGB value is left out of every window; a window with no finite pixel gives 0";
-    i.sweep_param = "radius";
-    i.sweep_values = {1, 2, 3, 4, 6};
     return i;
   }();
   return info;

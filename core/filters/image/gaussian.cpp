@@ -31,9 +31,7 @@ const FilterInfo& GaussianFilter::static_info() {
     i.reference = "Immonen 2017, sections 3.2 and 5.3 (Simple Blur), foveation fig. 5.1";
     i.params = with_common_params(with_foveation(
         {ParamSpec::Float("sigma", 1.0, 0.0, 21.0,
-                          "standard deviation in pixels; the window radius is ceil(3 sigma) (0 = no blur)"),
-         ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
-                          "firefly clamp: > 0 clamps every colour channel to [-clamp, clamp] before blurring; 0 = off")},
+                          "standard deviation in pixels; the window radius is ceil(3 sigma) (0 = no blur)")},
         {"sigma"}));
     i.required = {Role::Colour};
     i.nonfinite_policy =
@@ -41,15 +39,9 @@ const FilterInfo& GaussianFilter::static_info() {
         "a window with no finite pixel gives 0. Colour beyond [2^-20, 2^100] is scaled by an exact power of two "
         "while summing, so sums never overflow and tiny values keep their precision; results are clamped to the "
         "float range";
-    i.sweep_param = "sigma";
-    i.sweep_values = {0.5, 1, 1.5, 2, 3};
     return i;
   }();
   return info;
-}
-
-int GaussianFilter::radius_for(double sigma) {
-  return sigma > 0 ? int(std::ceil(3.0 * sigma - 1e-6)) : 0;
 }
 
 void GaussianFilter::check_params() { check_foveation_params(params_, info().name); }
@@ -64,12 +56,12 @@ void GaussianFilter::run(const Frame& frame, const Image& colour, const Roi& roi
 // weight sum as a fourth channel, so non-finite pixels (weight 0) and the clipped
 // borders are renormalised exactly as the 2D kernel would be.
 void GaussianFilter::run_separable(const Image& colour, double sigma, const Roi& roi, Image& out, int nthreads) {
-  const int r = radius_for(sigma);
+  const int r = gaussian_radius(sigma);
   std::vector<float> g(std::size_t(r) + 1, 1.0f);
   for (int k = 1; k <= r; ++k) g[std::size_t(k)] = float(std::exp(-double(k) * k / (2.0 * sigma * sigma)));
 
-  const Roi box = grow_roi(roi, r, colour.width(), colour.height());
-  planar_colour(colour, box, params_.get_float("clamp"), nthreads, cp_);
+  const Roi box = roi.grown(r, colour.width(), colour.height());
+  planar_colour(colour, box, 0.0, nthreads, cp_);
   const ColourPlanes& cp = cp_;
   const int bw = box.width(), bh = box.height(), rw = roi.width(), ox = roi.x0 - box.x0;
   const std::size_t hn = std::size_t(bh) * std::size_t(rw);
@@ -122,13 +114,13 @@ void GaussianFilter::run_per_pixel(const Image& colour, const Roi& roi, Image& o
   std::vector<int> row_max(std::size_t(roi.height()), 0);
   parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
     int m = 0;
-    for (int x = roi.x0; x < roi.x1; ++x) m = std::max(m, radius_for(sigma.at(fov.blend_at(x, y))));
+    for (int x = roi.x0; x < roi.x1; ++x) m = std::max(m, gaussian_radius(sigma.at(fov.blend_at(x, y))));
     row_max[std::size_t(y - roi.y0)] = m;
   });
   const int rmax = *std::max_element(row_max.begin(), row_max.end());
 
-  const Roi box = grow_roi(roi, rmax, w, h);
-  planar_colour(colour, box, params_.get_float("clamp"), nthreads, cp_);
+  const Roi box = roi.grown(rmax, w, h);
+  planar_colour(colour, box, 0.0, nthreads, cp_);
   const ColourPlanes& cp = cp_;
   const PlaneBox& pb = cp.pb;
   std::vector<float>& s = s_;
@@ -138,7 +130,7 @@ void GaussianFilter::run_per_pixel(const Image& colour, const Roi& roi, Image& o
   parallel_rows(box.y0, box.y1, nthreads, [&](int y) {
     for (int x = box.x0; x < box.x1; ++x) {
       const double sg = sigma.at(fov.blend_at(x, y));
-      rad[pb.index(x, y)] = float(radius_for(sg));
+      rad[pb.index(x, y)] = float(gaussian_radius(sg));
       s[pb.index(x, y)] = sg > 0 ? float(std::min(1e30, 1.0 / (2.0 * sg * sg))) : 0.0f;
     }
   });

@@ -13,8 +13,6 @@ class GaussianFilter : public Filter {
  public:
   GaussianFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
-  // Window radius used for a given sigma: ceil(3 sigma) (0 for sigma 0).
-  static int radius_for(double sigma);
 
  protected:
   void check_params() override;

@@ -8,6 +8,7 @@
 #include <cstring>
 #include <limits>
 
+#include "image/luminance.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -549,8 +550,6 @@ void run_bands(const Ctx& c, const Roi& roi, Image& out, int nthreads, int band_
   });
 }
 
-bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
-
 // The frame-wide pass (validity flags, guide normalisation, outlier threshold),
 // then the bands. Every reduction is per row, then combined in row order: the
 // same numbers on any thread count.
@@ -730,8 +729,6 @@ const FilterInfo& GuidedFilter::static_info() {
         ParamSpec::Float("epsilon", 0.01, 1e-8, 1e6,
                          "ridge regulariser added to the guide covariance (guide channels normalised, see guide): "
                          "larger = smoother, towards a box-of-box mean"),
-        ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
-                         "clamp colour channels to [-clamp, clamp] before filtering, against fireflies (0 = off)"),
     });
     i.required = {Role::Colour};
     i.optional = {Role::Normal, Role::Depth, Role::Position, Role::Albedo};
@@ -744,8 +741,6 @@ const FilterInfo& GuidedFilter::static_info() {
         "inputs up to FLT_MAX never overflow. Fireflies: the guided filter spreads a bright pixel over the windows "
         "holding it (up to 2r away, like a box filter); colour values >= 2^20 x the 90th percentile of |colour| "
         "have sums of their own, so pixels farther than 2r never see their rounding error; clamp limits them";
-    i.sweep_param = "radius";
-    i.sweep_values = {2, 4, 8, 12, 16, 24};
     return i;
   }();
   return info;
@@ -776,17 +771,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   }
   const int W = frame.width, H = frame.height;
   const int r = int(params_.get_int("radius"));
-  const double clamp_to = params_.get_float("clamp");
-
-  Image clamped;
   const Image* colour = &colour_in;
-  if (clamp_to > 0.0) {
-    clamped = colour_in;
-    const float lim = float(std::min(clamp_to, double(FLT_MAX)));
-    for (float& v : clamped.storage())
-      if (std::isfinite(v)) v = std::clamp(v, -lim, lim);
-    colour = &clamped;
-  }
   Image lum;
 
   // Guide channels, grouped by pass (a group shares one scale).
@@ -808,7 +793,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
       parallel_rows(0, H, nthreads, [&](int y) {
         for (int x = 0; x < W; ++x) {
           const float* p = colour->pixel(x, y);
-          const double v = 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2];
+          const double v = luminance(p);
           lum.at(x, y, 0) = finite3(p) ? float(std::clamp(v, -double(FLT_MAX), double(FLT_MAX)))
                                        : std::numeric_limits<float>::quiet_NaN();
         }

@@ -9,6 +9,10 @@
 #include <string>
 #include <type_traits>
 
+#include "image/luminance.h"
+#include "kernels/fast_exp.h"
+#include "kernels/noise_variance.h"
+#include "prepare/outliers.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -22,12 +26,6 @@ constexpr double kMaxExponent = 1e300;
 
 using Clock = std::chrono::steady_clock;
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
-
-bool finite3(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
-
-Roi grown(const Roi& r, int by, int w, int h) {
-  return Roi{std::max(0, r.x0 - by), std::max(0, r.y0 - by), std::min(w, r.x1 + by), std::min(h, r.y1 + by)};
-}
 
 // A geometric feature pass and its Gaussian's 1 / (2 sigma^2).
 struct Feature {
@@ -83,30 +81,6 @@ Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing) {
   return f;
 }
 
-// exp(-d) for d in [0, 40]: 2^-(d log2 e) split into 2^n (exponent bits) times 2^f,
-// |f| <= 1/2, with e^(f ln 2) by its Taylor series to degree 11 (relative error < 1e-14).
-// Several times faster than std::exp and the same on every machine.
-inline double exp_neg(double d) {
-  const double t = -d * 1.4426950408889634;  // log2(e)
-  const double n = -double(std::int64_t(0.5 - t));  // round half up, t <= 0
-  const double x = (t - n) * 0.6931471805599453;  // ln 2, |x| <= 0.347
-  double p = 1.0 / 39916800.0;
-  p = p * x + 1.0 / 3628800.0;
-  p = p * x + 1.0 / 362880.0;
-  p = p * x + 1.0 / 40320.0;
-  p = p * x + 1.0 / 5040.0;
-  p = p * x + 1.0 / 720.0;
-  p = p * x + 1.0 / 120.0;
-  p = p * x + 1.0 / 24.0;
-  p = p * x + 1.0 / 6.0;
-  p = p * x + 0.5;
-  p = p * x + 1.0;
-  p = p * x + 1.0;
-  const std::int64_t bits = (std::int64_t(n) + 1023) << 52;  // n in [-58, 0]: a normal double
-  double scale;
-  std::memcpy(&scale, &bits, sizeof scale);
-  return p * scale;
-}
 
 inline double dist2(const float* a, const float* b) {
   const double d0 = double(a[0]) - double(b[0]), d1 = double(a[1]) - double(b[1]), d2 = double(a[2]) - double(b[2]);
@@ -120,8 +94,6 @@ inline double dist2(const float* a, const float* b) {
 
 namespace pwaf {
 
-double luminance(const float* rgb) { return 0.2126 * double(rgb[0]) + 0.7152 * double(rgb[1]) + 0.0722 * double(rgb[2]); }
-
 double relative_variance(double variance, double lum) { return variance / (lum * lum + 0.01); }
 
 int window_radius(double rel_variance, double rho_max, int min_r, int max_r) {
@@ -131,144 +103,6 @@ int window_radius(double rel_variance, double rho_max, int min_r, int max_r) {
   return min_r + int(std::lround(t * double(max_r - min_r)));
 }
 
-OutlierResult suppress_outliers(const Image& colour, int radius, double k, const Roi& region, int nthreads) {
-  const int w = colour.width(), h = colour.height();
-  OutlierResult res;
-  res.colour = colour;
-  res.valid.assign(std::size_t(w) * h, 1);
-  res.replaced.assign(std::size_t(w) * h, 0);
-  if (region.empty()) return res;
-  // Luminance of every pixel the windows read, NaN where a channel is not finite.
-  const Roi lr = grown(region, radius, w, h);
-  const int lw = lr.width();
-  std::vector<double> lum(std::size_t(lw) * lr.height());
-  parallel_rows(lr.y0, lr.y1, nthreads, [&](int y) {
-    for (int x = lr.x0; x < lr.x1; ++x) {
-      const float* q = colour.pixel(x, y);
-      lum[std::size_t(y - lr.y0) * lw + (x - lr.x0)] = finite3(q) ? luminance(q) : std::numeric_limits<double>::quiet_NaN();
-    }
-  });
-  parallel_rows(region.y0, region.y1, nthreads, [&](int y) {
-    const int y0 = std::max(0, y - radius), y1 = std::min(h - 1, y + radius);
-    for (int x = region.x0; x < region.x1; ++x) {
-      const int x0 = std::max(0, x - radius), x1 = std::min(w - 1, x + radius);
-      const double lp = lum[std::size_t(y - lr.y0) * lw + (x - lr.x0)];
-      const bool finite = !std::isnan(lp);
-      // Mean and standard deviation (two passes) of the finite neighbours, centre excluded.
-      double mu = 0;
-      std::size_t n = 0;
-      for (int yy = y0; yy <= y1; ++yy) {
-        const double* row = &lum[std::size_t(yy - lr.y0) * lw - lr.x0];
-        for (int xx = x0; xx <= x1; ++xx)
-          if (!std::isnan(row[xx]) && (xx != x || yy != y)) { mu += row[xx]; ++n; }
-      }
-      const std::size_t i = std::size_t(y) * w + x;
-      float* o = res.colour.pixel(x, y);
-      std::uint8_t why = 0;
-      if (!finite) {
-        if (n == 0) {
-          o[0] = o[1] = o[2] = 0.0f;
-          res.valid[i] = 0;
-          continue;
-        }
-        why = 2;
-      } else if (k > 0 && n >= 3) {
-        mu /= double(n);
-        double var = 0;
-        for (int yy = y0; yy <= y1; ++yy) {
-          const double* row = &lum[std::size_t(yy - lr.y0) * lw - lr.x0];
-          for (int xx = x0; xx <= x1; ++xx)
-            if (!std::isnan(row[xx]) && (xx != x || yy != y)) var += (row[xx] - mu) * (row[xx] - mu);
-        }
-        const double excess = lp - mu;
-        if (excess > k * std::sqrt(var / double(n)) && excess > 0.01 * std::fabs(mu)) why = 1;
-      }
-      if (!why) continue;
-      // Replace by the mean RGB of the same neighbours.
-      double sum[3] = {0, 0, 0};
-      for (int yy = y0; yy <= y1; ++yy)
-        for (int xx = x0; xx <= x1; ++xx) {
-          if (xx == x && yy == y) continue;
-          const float* q = colour.pixel(xx, yy);
-          if (!finite3(q)) continue;
-          for (int c = 0; c < 3; ++c) sum[c] += double(q[c]);
-        }
-      for (int c = 0; c < 3; ++c) o[c] = float(std::clamp(sum[c] / double(n), -kFloatMax, kFloatMax));
-      res.replaced[i] = why;
-    }
-  });
-  return res;
-}
-
-std::vector<double> estimate_variance(const Image& colour, const std::vector<std::uint8_t>& valid,
-                                      const Image* sample_count, int radius, const Roi& region, int nthreads) {
-  const int w = colour.width(), h = colour.height();
-  std::vector<double> v(std::size_t(w) * h, 0.0);
-  if (region.empty()) return v;
-  auto inv_n = [&](int x, int y) {
-    if (!sample_count) return 1.0;
-    const double n = double(sample_count->pixel(x, y)[0]);
-    return std::isfinite(n) && n > 1.0 ? 1.0 / n : 1.0;
-  };
-  // Residuals on the region grown by the window radius.
-  const Roi e_reg = grown(region, radius, w, h);
-  const int ew = e_reg.width();
-  std::vector<double> e2(std::size_t(ew) * e_reg.height(), 0.0);  // mean over RGB of e_c^2
-  std::vector<double> a(e2.size(), 0.0);                           // its expected value / s^2
-  parallel_rows(e_reg.y0, e_reg.y1, nthreads, [&](int y) {
-    for (int x = e_reg.x0; x < e_reg.x1; ++x) {
-      if (!valid[std::size_t(y) * w + x]) continue;
-      double mean[3] = {0, 0, 0}, sum_inv = 0;
-      int m = 0;
-      for (int yy = std::max(0, y - 1); yy <= std::min(h - 1, y + 1); ++yy)
-        for (int xx = std::max(0, x - 1); xx <= std::min(w - 1, x + 1); ++xx) {
-          if ((xx == x && yy == y) || !valid[std::size_t(yy) * w + xx]) continue;
-          const float* q = colour.pixel(xx, yy);
-          for (int c = 0; c < 3; ++c) mean[c] += double(q[c]);
-          sum_inv += inv_n(xx, yy);
-          ++m;
-        }
-      if (m == 0) continue;
-      const float* p = colour.pixel(x, y);
-      double s = 0;
-      for (int c = 0; c < 3; ++c) {
-        const double r = double(p[c]) - mean[c] / m;
-        s += r * r;
-      }
-      const std::size_t j = std::size_t(y - e_reg.y0) * ew + (x - e_reg.x0);
-      e2[j] = s / 3.0;
-      a[j] = inv_n(x, y) + sum_inv / (double(m) * double(m));
-    }
-  });
-  // Window sums, separable (rows, then columns), each a direct sum: no running sums whose
-  // cancellation a 1e30 neighbour could spoil.
-  std::vector<double> re(std::size_t(region.width()) * e_reg.height()), ra(re.size());
-  const int rw = region.width();
-  parallel_rows(e_reg.y0, e_reg.y1, nthreads, [&](int y) {
-    const std::size_t row = std::size_t(y - e_reg.y0) * ew;
-    for (int x = region.x0; x < region.x1; ++x) {
-      double se = 0, sa = 0;
-      for (int xx = std::max(e_reg.x0, x - radius); xx <= std::min(e_reg.x1 - 1, x + radius); ++xx) {
-        se += e2[row + (xx - e_reg.x0)];
-        sa += a[row + (xx - e_reg.x0)];
-      }
-      re[std::size_t(y - e_reg.y0) * rw + (x - region.x0)] = se;
-      ra[std::size_t(y - e_reg.y0) * rw + (x - region.x0)] = sa;
-    }
-  });
-  parallel_rows(region.y0, region.y1, nthreads, [&](int y) {
-    for (int x = region.x0; x < region.x1; ++x) {
-      double se = 0, sa = 0;
-      for (int yy = std::max(e_reg.y0, y - radius); yy <= std::min(e_reg.y1 - 1, y + radius); ++yy) {
-        se += re[std::size_t(yy - e_reg.y0) * rw + (x - region.x0)];
-        sa += ra[std::size_t(yy - e_reg.y0) * rw + (x - region.x0)];
-      }
-      const double s2 = sa > 0 ? se / sa : 0.0;
-      v[std::size_t(y) * w + x] = std::isfinite(s2) ? s2 * inv_n(x, y) : std::numeric_limits<double>::max();
-    }
-  });
-  return v;
-}
 
 }  // namespace pwaf
 
@@ -305,8 +139,6 @@ const FilterInfo& PwafFilter::static_info() {
         "that feature's Gaussian off (factor 1) for every pair that involves the pixel; a non-finite or negative "
         "variance-pass value is ignored (the estimate is used where none is left); all arithmetic is in double and "
         "outputs are clamped to the float range, so no NaN/Inf is ever produced";
-    i.sweep_param = "max_radius";
-    i.sweep_values = {4, 6, 8, 12};
     return i;
   }();
   return info;
@@ -337,8 +169,8 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // stage runs on what the next one reads and each value depends only on the input, so a roi
   // gives the same pixels as the whole frame, and tiles agree at their seams.
   const Roi stat = adaptive ? Roi::all(w, h) : roi;
-  const Roi support = grown(stat, std::max({max_r, pf_r, var_r + 1}), w, h);
-  pwaf::OutlierResult os = pwaf::suppress_outliers(colour, os_r, outlier_k, support, nthreads);
+  const Roi support = stat.grown(std::max({max_r, pf_r, var_r + 1}), w, h);
+  OutlierResult os = replace_outliers(colour, os_r, outlier_k, support, nthreads);
   for (int y = support.y0; y < support.y1; ++y)
     for (int x = support.x0; x < support.x1; ++x) {
       const std::uint8_t r = os.replaced[std::size_t(y) * w + x];
@@ -357,19 +189,16 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     stats_.variance_from_pass = true;
     const Image& vi = vpass->image;
     const int vc = std::min(3, vi.channels());
-    // With demodulate=true the colour was divided by the albedo (clamped as the base class
-    // does): the variance of I_c / a_c is Var(I_c) / a_c^2, so the pass is divided likewise
-    // (a 1-channel pass by the mean of 1 / a_c^2).
-    const Pass* albedo = params_.get_bool("demodulate") ? frame.find(Role::Albedo) : nullptr;
-    const float floor = float(params_.get_float("albedo_floor"));
+    // When the colour was demodulated (divided by a_c), the variance of I_c / a_c is
+    // Var(I_c) / a_c^2, so the pass is divided likewise (a 1-channel pass by the mean of
+    // 1 / a_c^2).
+    const Image* divisor = demodulation_divisor();
     auto inv_a2 = [&](int x, int y, int c) {
-      if (!albedo) return 1.0;
-      const Image& ai = albedo->image;
-      const float v = ai.pixel(x, y)[std::min(c, ai.channels() - 1)];
-      const double a = double(demodulation_albedo(v, floor));
+      if (!divisor) return 1.0;
+      const double a = double(divisor->pixel(x, y)[c]);
       return 1.0 / (a * a);
     };
-    const Roi vreg = grown(stat, var_r, w, h);
+    const Roi vreg = stat.grown(var_r, w, h);
     const int vw = vreg.width();
     std::vector<double> pv(std::size_t(vw) * vreg.height(), -1.0);  // -1: invalid
     parallel_rows(vreg.y0, vreg.y1, nthreads, [&](int y) {
@@ -401,13 +230,13 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       }
     });
     if (std::find(need_estimate.begin(), need_estimate.end(), 1) != need_estimate.end()) {
-      const std::vector<double> est = pwaf::estimate_variance(in, valid, spp ? &spp->image : nullptr, var_r, stat, nthreads);
+      const std::vector<double> est = estimate_variance(in, valid, spp ? &spp->image : nullptr, var_r, stat, nthreads);
       for (std::size_t i = 0; i < variance.size(); ++i)
         if (need_estimate[i]) variance[i] = est[i];
       note("pwaf: variance pass has no valid value around some pixels; variance estimated there from the image");
     }
   } else {
-    variance = pwaf::estimate_variance(in, valid, spp ? &spp->image : nullptr, var_r, stat, nthreads);
+    variance = estimate_variance(in, valid, spp ? &spp->image : nullptr, var_r, stat, nthreads);
     note(std::string("pwaf: no variance pass; variance estimated from high-pass residuals over ") +
          std::to_string(2 * var_r + 1) + "x" + std::to_string(2 * var_r + 1) + " windows" +
          (spp ? ", per sample, divided by the sample count" : ""));
@@ -462,7 +291,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     parallel_rows(0, h, nthreads, [&](int y) {
       for (int x = 0; x < w; ++x) {
         const std::size_t i = std::size_t(y) * w + x;
-        rho[i] = pwaf::relative_variance(variance[i], pwaf::luminance(est.pixel(x, y)));
+        rho[i] = pwaf::relative_variance(variance[i], luminance(est.pixel(x, y)));
       }
     });
     std::vector<double> sorted;
@@ -513,7 +342,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // then the used features (3 floats each, non-finite ones zeroed); mask bit 0 = valid colour,
   // bit k+1 = feature k finite.
   const int stride = 3 + 3 * nf;
-  const Roi fr = grown(roi, max_r, w, h);
+  const Roi fr = roi.grown(max_r, w, h);
   const int fw = fr.width();
   std::vector<float> pk(std::size_t(fw) * fr.height() * stride, 0.0f);
   std::vector<std::uint8_t> mask(std::size_t(fw) * fr.height(), 0);
@@ -557,7 +386,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
         // Gc against the estimated range value, sigma_c(p)^2 = sigma_c^2 v(p) + (1e-3 Y(p))^2 +
         // 1e-300: the pixel's noise level sets the colour scale (3.3); the floors keep a
         // noise-free pixel from dividing by zero.
-        const double yl = pwaf::luminance(ip);
+        const double yl = luminance(ip);
         const double sc2 = sigma_c * sigma_c * std::min(variance[i], 1e300) + 1e-6 * yl * yl + 1e-300;
         const double kc = 1.0 / (6.0 * sc2);  // mean over the 3 channels, then 1/(2 sigma^2)
         const std::size_t ip_k = std::size_t(y - fr.y0) * fw + (x - fr.x0);
@@ -597,7 +426,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
         for (std::size_t k = 0; k < n; ++k) {
           const double d = ex[k] - emin;
           if (d > 40.0) continue;
-          const double wgt = exp_neg(d);
+          const double wgt = exp_neg_d(d);
           const float* q = &pk[at[k] * S];
           s0 += wgt * double(q[0]);
           s1 += wgt * double(q[1]);

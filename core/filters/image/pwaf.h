@@ -62,9 +62,6 @@ class PwafFilter : public Filter {
 // The building blocks, public so the tests can check each rule on its own.
 namespace pwaf {
 
-// Luminance Y = 0.2126 R + 0.7152 G + 0.0722 B, in double (no overflow for any float).
-double luminance(const float* rgb);
-
 // 3.2: radius = min_r + round(t * (max_r - min_r)), t = clamp(rel_variance / rho_max, 0, 1).
 // The filter passes rho_max = variance_max * (the frame's median rel_variance). rho_max <= 0
 // (a noise-free frame) gives min_r for rel_variance 0 and max_r above. A non-finite or
@@ -75,36 +72,6 @@ int window_radius(double rel_variance, double rho_max, int min_r, int max_r);
 // estimated range value. The 0.01 is the relMSE metric's: rho is the pixel's expected
 // contribution to relMSE if it were left unfiltered.
 double relative_variance(double variance, double luminance);
-
-// 3.3 outlier replacement on `region` (pixels outside are copied from colour). For each pixel p,
-// over the other pixels of its (2*radius+1)^2 window clipped at the image (the centre excluded)
-// that have finite RGB:
-//   mu, sd = mean and standard deviation of their luminance (n >= 3 needed to judge)
-//   p is an outlier iff Y(p) - mu > k * sd and Y(p) - mu > 0.01 * |mu|   (bright spikes only)
-// An outlier, and any pixel with a non-finite channel, is replaced by the mean RGB of those
-// finite neighbours. A non-finite pixel with no finite neighbour is set to 0 and marked invalid
-// (valid[i] = 0); every other pixel is valid. replaced[i] = 1 where an outlier was replaced,
-// 2 where a non-finite pixel was. k <= 0 disables the outlier rule (non-finite repair stays).
-struct OutlierResult {
-  Image colour;                        // full size; the replaced image inside region
-  std::vector<std::uint8_t> valid;     // full size, 1 outside region too
-  std::vector<std::uint8_t> replaced;  // full size
-};
-OutlierResult suppress_outliers(const Image& colour, int radius, double k, const Roi& region, int nthreads);
-
-// Colour variance estimate (variance of the pixel value, mean over R, G, B) for the pixels of
-// `region`, from the image alone:
-//   e_c(q) = I_c(q) - mean of I_c over q's valid 8-neighbours (m of them, clipped at borders),
-//   a high-pass residual that a locally linear signal does not reach. For noise of per-sample
-//   variance s^2 and n(q) samples per pixel, Var e_c(q) = s^2 * a(q) with
-//   a(q) = 1/n(q) + (1/m^2) * sum over those neighbours of 1/n.
-//   s^2(p) = sum over q in the (2*radius+1)^2 window of p of mean_c e_c(q)^2 / sum of a(q),
-//   v(p)   = s^2(p) / n(p).
-// n comes from sample_count (1 channel) when given, clamped to >= 1 with non-finite read as 1;
-// without it n = 1 everywhere, so v is the plain pixel variance. Invalid pixels (valid[i] == 0)
-// take no part. Returns a full-size vector, filled inside region only (0 elsewhere).
-std::vector<double> estimate_variance(const Image& colour, const std::vector<std::uint8_t>& valid,
-                                      const Image* sample_count, int radius, const Roi& region, int nthreads);
 
 }  // namespace pwaf
 

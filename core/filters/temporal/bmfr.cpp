@@ -7,6 +7,7 @@
 #include <limits>
 #include <ctime>
 
+#include "prepare/demodulation.h"
 #include "util/avx2_shuffles.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -45,7 +46,10 @@ const FilterInfo& BmfrFilter::static_info() {
     i.name = "bmfr";
     i.summary = "Blockwise multi-order feature regression: temporal accumulation, per-block QR fit, TAA";
     i.reference = "Koskela et al., Blockwise Multi-Order Feature Regression for real-time path tracing reconstruction, ACM TOG 2019";
-    i.params = with_common_params({
+    // Demodulation is bmfr's own (fused into phase I, remodulated before TAA): it takes
+    // every preparation step but that one.
+    i.steps.demodulate = false;
+    i.params = with_preparation_params({
         ParamSpec::Int("block_size", 0, 0, 128,
                        "side of the square regression blocks in pixels (8..128); 0 = auto: 32 (the paper's) when the "
                        "shorter image side is >= 360 pixels, 16 below"),
@@ -71,15 +75,18 @@ const FilterInfo& BmfrFilter::static_info() {
                         "accumulated input (the paper clamps only at 0 implicitly; guards ill-conditioned blocks)"),
         ParamSpec::Int("seed", 0, 0, 2147483647, "seed of the regularisation noise"),
         ParamSpec::Bool("albedo_demodulation", true,
-                        "fit illumination = colour / max(albedo, albedo_floor) and multiply back before TAA (when an albedo pass "
-                        "exists); skipped when the common demodulate=true does it instead (around the whole pipeline)"),
+                        "fit illumination = colour / max(albedo, albedo_floor) and multiply back before TAA (when an albedo "
+                        "pass exists)"),
+        ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0,
+                         "albedo_demodulation raises the albedo to at least this (no upper clamp: Blender's albedo "
+                         "exceeds 1 on highlights)"),
         ParamSpec::Enum("position_test", "relative", {"relative", "absolute"},
                         "history discard by world distance: relative = in pixel footprints, absolute = world units"),
         ParamSpec::Float("position_threshold", 3.0, 0.0, 1e9, "history tap kept when its world distance is at most this"),
         ParamSpec::Float("normal_threshold", 0.9, -1.0, 1.0, "history tap kept when the cosine between normals is at least this"),
         ParamSpec::Float("cut_fraction", 0.9, 0.0, 1.0,
                          "camera cut: history restarts when more than this fraction of pixels lose every tap"),
-    });
+    }, i.steps);
     i.required = {Role::Colour, Role::Normal, Role::Position};
     i.optional = {Role::Albedo, Role::Motion, Role::Depth};
     i.temporal = true;
@@ -88,8 +95,6 @@ const FilterInfo& BmfrFilter::static_info() {
         "NaN/Inf position or normal: no history for that pixel, left out of the fit, its features read as mid-range; "
         "NaN/Inf albedo reads as 1; NaN/Inf motion means no history; a block with no valid pixel keeps the history "
         "(0 without one); outputs are clamped to the float range";
-    i.sweep_param = "block_size";
-    i.sweep_values = {16, 32, 64};
     return i;
   }();
   return info;
@@ -151,21 +156,6 @@ __attribute__((target("avx2"))) int remodulate_row_avx2(const float* s, const fl
   return x;
 }
 
-// The demodulation of n interleaved floats (RGB albedo): a = finite(v) ? max(v, lo) : 1,
-// il = co / a, 8 at a time; returns the first not done.
-__attribute__((target("avx2"))) std::size_t demodulate_avx2(const float* ad, const float* co, float lo, std::size_t n,
-                                                            float* al, float* il) {
-  const __m256 lo8 = _mm256_set1_ps(lo), one = _mm256_set1_ps(1.0f), zero = _mm256_setzero_ps();
-  std::size_t j = 0;
-  for (; j + 8 <= n; j += 8) {
-    const __m256 v = _mm256_loadu_ps(ad + j);
-    const __m256 fin = _mm256_cmp_ps(_mm256_sub_ps(v, v), zero, _CMP_EQ_OQ);
-    const __m256 a = _mm256_blendv_ps(one, _mm256_max_ps(lo8, v), fin);  // std::max(v, lo) = max_ps(lo, v)
-    _mm256_storeu_ps(al + j, a);
-    _mm256_storeu_ps(il + j, _mm256_div_ps(_mm256_loadu_ps(co + j), a));
-  }
-  return j;
-}
 #endif
 }  // namespace
 
@@ -184,13 +174,8 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // Albedo guard: [albedo_floor, inf) per channel, non-finite reads as 1.
   const std::size_t n = std::size_t(w) * h;
   const Pass* ap = frame.find(Role::Albedo);
-  // The common `demodulate` parameter, when set, has the base class divide before run()
-  // and multiply after (TAA then sees the illumination): our own step is skipped so the
-  // albedo is divided out exactly once.
-  const bool base_demod = params_.get_bool("demodulate");
-  const bool demod = params_.get_bool("albedo_demodulation") && ap && !base_demod;
+  const bool demod = params_.get_bool("albedo_demodulation") && ap;
   if (params_.get_bool("albedo_demodulation") && !ap) note("no albedo pass: the colour is fitted without demodulation");
-  if (params_.get_bool("albedo_demodulation") && base_demod) note("demodulate=true: the base class demodulates; albedo_demodulation skipped");
   // Demodulation fused into phase I: row y of the illumination is made right before
   // phase I reads it.
   std::function<void(int)> demod_row;
@@ -199,33 +184,8 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     ensure_image(albedo_, w, h, 3);
     const float lo = float(params_.get_float("albedo_floor"));
     const Image& ai = ap->image;
-    const int ach = ai.channels();
-    demod_row = [&, lo, ach](int y) {
-      const std::size_t b = std::size_t(y) * w, e = b + std::size_t(w);
-      float* il = illum_.data();
-      float* al = albedo_.data();
-      const float* co = colour.data();
-      const float* ad = ai.data();
-      if (ach == 3) {  // the usual RGB albedo: one flat, vectorisable loop
-        std::size_t j0 = b * 3;
-#ifdef MCR_BMFR_AVX2
-        if (isa_at_least(Isa::Avx2)) j0 += demodulate_avx2(ad + j0, co + j0, lo, (e - b) * 3, al + j0, il + j0);
-#endif
-        for (std::size_t j = j0; j < e * 3; ++j) {
-          const float v = ad[j];
-          const float a = demodulation_albedo(v, lo);
-          al[j] = a;
-          il[j] = co[j] / a;
-        }
-        return;
-      }
-      for (std::size_t i = b; i < e; ++i)
-        for (int c = 0; c < 3; ++c) {
-          const float v = ad[i * std::size_t(ach) + std::size_t(std::min(c, ach - 1))];
-          const float a = demodulation_albedo(v, lo);
-          al[i * 3 + c] = a;
-          il[i * 3 + c] = co[i * 3 + c] / a;
-        }
+    demod_row = [&, lo](int y) {
+      demodulate_row(ai.pixel(0, y), ai.channels(), colour.pixel(0, y), w, lo, albedo_.pixel(0, y), illum_.pixel(0, y));
     };
   }
 

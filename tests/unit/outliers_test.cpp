@@ -1,5 +1,5 @@
-// Firefly suppression (filters/fireflies.h) against hand-computed window statistics.
-#include "prepare/fireflies.h"
+// The outlier rule and its repairs (prepare/outliers.h) against hand-computed window statistics.
+#include "prepare/outliers.h"
 
 #include <gtest/gtest.h>
 
@@ -14,6 +14,14 @@ namespace mcr {
 namespace {
 
 double lum(const float* p) { return 0.2126 * p[0] + 0.7152 * p[1] + 0.0722 * p[2]; }
+
+// clamp_fireflies over the whole image, on a copy.
+Image suppress_fireflies(const Image& in, int radius, double k, int nthreads, std::size_t* n = nullptr) {
+  Image out = in;
+  const std::size_t hits = clamp_fireflies(out, radius, k, Roi::all(in.width(), in.height()), nthreads);
+  if (n) *n = hits;
+  return out;
+}
 
 Image grey(int w, int h, float v) { return Image(w, h, 3, v); }
 

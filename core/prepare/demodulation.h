@@ -1,0 +1,25 @@
+#pragma once
+// Albedo demodulation (preparation step `demodulate`, and bmfr's own fused one): the
+// colour is divided by the albedo so a filter smooths the illumination, not the
+// texture, and multiplied back after. One rule for every user:
+//   a = max(albedo, floor) where the albedo is finite, 1 where it is not;
+// no upper clamp (Blender's Denoising Albedo exceeds 1 on highlights, >100 near
+// lights), and dividing and multiplying by the same value is exact.
+#include <algorithm>
+
+#include "image/image.h"
+
+namespace mcr {
+
+inline float demodulation_albedo(float v, float floor) { return (v - v == 0.0f) ? std::max(v, floor) : 1.0f; }
+
+// One row of n pixels: al = the divisor per channel (an albedo of fewer than 3 channels
+// repeats its last one), il = colour / al. colour, al and il are RGB.
+void demodulate_row(const float* albedo, int albedo_channels, const float* colour, int n, float floor, float* al,
+                    float* il);
+
+// Inside roi: divisor(x, y) = the rule above on `albedo`, colour(x, y) /= divisor. Both
+// RGB, the frame's size; pixels outside roi are not touched.
+void demodulate(const Image& albedo, float floor, const Roi& roi, int nthreads, Image& divisor, Image& colour);
+
+}  // namespace mcr

@@ -1,0 +1,227 @@
+#include "prepare/preparation.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "prepare/albedo_prefilter.h"
+#include "prepare/demodulation.h"
+#include "prepare/outliers.h"
+#include "prepare/pull_push.h"
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
+  if (steps.demodulate) {
+    own.push_back(ParamSpec::Bool("demodulate", false, "divide the colour by the albedo pass before filtering and multiply after"));
+    own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0,
+                                   "albedo is raised to at least albedo_floor for demodulation (no upper clamp: colour is "
+                                   "divided and multiplied by the same value, and Blender's albedo exceeds 1 on highlights)"));
+  }
+  if (steps.albedo_prefilter) {
+    own.push_back(ParamSpec::Float("albedo_prefilter", 0.0, 0.0, 10.0,
+                                   "smooth the albedo pass before it is used (demodulation and albedo weights): range sigma, "
+                                   "in log albedo, of a first-order cross-bilateral fit on normal and position (1 px; NFOR's "
+                                   "feature prefiltering): a 16-spp albedo carries coverage and glossy-bounce noise that "
+                                   "remodulation puts back; 0 = off"));
+    own.push_back(ParamSpec::Float("albedo_prefilter_position", 0.03, 1e-6, 1e6, "position sigma of albedo_prefilter, in scene units"));
+  }
+  if (steps.holes) {
+    own.push_back(ParamSpec::Enum("holes", "auto", {"auto", "none", "sample_count", "alpha"},
+                                  "unsampled pixels to fill by pull-push first: auto = sample_count 0 when that pass exists"));
+  }
+  if (steps.outliers) {
+    own.push_back(ParamSpec::Float("firefly_k", 0.0, 0.0, 1e3,
+                                   "firefly suppression before filtering (after demodulation, on the illumination): a pixel whose "
+                                   "luminance exceeds mu + max(k sd, 0.01 |mu|) of its window's other pixels is scaled down to "
+                                   "that limit (Guo & Pan 2012, 3.3, clamping instead of replacing); 0 = off"));
+    own.push_back(ParamSpec::Int("firefly_radius", 3, 1, 8, "half width of the firefly statistics window"));
+    own.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
+                                   "clamp every colour channel to [-clamp, clamp] before filtering (after demodulation and "
+                                   "firefly suppression); 0 = off"));
+  }
+  return own;
+}
+
+namespace {
+
+double fval(const ParamSet& p, const char* name) { return p.has(name) ? p.get_float(name) : 0.0; }
+bool demodulating(const ParamSet& p) { return p.has("demodulate") && p.get_bool("demodulate"); }
+
+Role hole_role(const std::string& mode) { return mode == "alpha" ? Role::Alpha : Role::SampleCount; }
+
+// Weight 0 for unsampled pixels, 1 otherwise; empty when nothing is missing.
+std::vector<float> hole_weights(const Frame& frame, const std::string& mode) {
+  if (mode == "none") return {};
+  const Role role = hole_role(mode);
+  const Pass* p = frame.find(role);
+  if (!p) {
+    if (mode == "auto") return {};
+    throw Error(Errc::MissingPass, "holes=" + mode + " needs the " + role_name(role) + " pass, absent in '" + frame.path + "'");
+  }
+  std::vector<float> w(p->image.pixel_count());
+  bool any = false;
+  for (std::size_t i = 0; i < w.size(); ++i) {
+    const float v = p->image.data()[i * std::size_t(p->image.channels())];
+    w[i] = v > 0.0f ? 1.0f : 0.0f;
+    any = any || w[i] == 0.0f;
+  }
+  return any ? w : std::vector<float>{};
+}
+
+// The frame run() reads, copied on the first change.
+Frame& own_frame(const Frame& frame, Prepared& out) {
+  if (out.frame != &out.own) {
+    out.own = frame;
+    out.frame = &out.own;
+  }
+  return out.own;
+}
+
+}  // namespace
+
+void preparation_needs(const ParamSet& params, const PrepSteps& steps, std::vector<Role>& required,
+                       std::vector<std::string>& why, std::vector<Role>& optional) {
+  if (steps.demodulate && demodulating(params)) {
+    required.push_back(Role::Albedo);
+    why.push_back("demodulate=true");
+  }
+  if (steps.albedo_prefilter && fval(params, "albedo_prefilter") > 0) {
+    for (Role r : {Role::Albedo, Role::Normal, Role::Position}) optional.push_back(r);
+  }
+  if (steps.holes) {
+    const std::string& mode = params.get_enum("holes");
+    if (mode == "auto") {
+      optional.push_back(Role::SampleCount);
+    } else if (mode != "none") {
+      required.push_back(hole_role(mode));
+      why.push_back("holes=" + mode);
+    }
+  }
+}
+
+std::vector<std::string> preparation_unused(const ParamSet& params, const PrepSteps& steps) {
+  std::vector<std::string> notes;
+  auto unused = [&](const char* name, const std::string& why) {
+    if (params.has(name) && params.was_set(name)) notes.push_back(std::string(name) + " has no effect " + why);
+  };
+  if (steps.outliers && !(fval(params, "firefly_k") > 0)) unused("firefly_radius", "with firefly_k=0");
+  if (steps.albedo_prefilter && !(fval(params, "albedo_prefilter") > 0))
+    unused("albedo_prefilter_position", "with albedo_prefilter=0");
+  if (steps.demodulate && !demodulating(params)) unused("albedo_floor", "with demodulate=false");
+  return notes;
+}
+
+Image rgb_copy(const Image& input, int nthreads) {
+  if (input.channels() < 3) (void)input.channel_range(0, 3);  // throws: no RGB
+  Image colour(input.width(), input.height(), 3);
+  const int ich = input.channels();
+  const std::size_t iw = std::size_t(input.width());
+  parallel_rows(0, input.height(), nthreads, [&](int y) {
+    const float* s = input.data() + std::size_t(y) * iw * std::size_t(ich);
+    float* d = colour.data() + std::size_t(y) * iw * 3;
+    if (ich == 3) {
+      std::copy(s, s + iw * 3, d);
+      return;
+    }
+    for (std::size_t x = 0; x < iw; ++x)
+      for (int c = 0; c < 3; ++c) d[x * 3 + std::size_t(c)] = s[x * std::size_t(ich) + std::size_t(c)];
+  });
+  return colour;
+}
+
+void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps, const Roi& work_in, int nthreads,
+             Prepared& out) {
+  out.frame = &frame;
+  out.notes.clear();
+  out.divisor = Image();
+  const int w = frame.width, h = frame.height;
+  const Roi work = work_in.clipped(w, h);
+  // Each step reads around the region of the next: fireflies read their window.
+  const bool fireflies = steps.outliers && params.get_float("firefly_k") > 0;
+  const Roi demod_region = fireflies ? work.grown(int(params.get_int("firefly_radius")), w, h) : work;
+
+  // Sparse renders: fill every pass at the unsampled pixels first (thesis 5.1). The
+  // pull-push pyramid spans the frame, so this step fills the whole frame.
+  if (steps.holes) {
+    const std::vector<float> holes = hole_weights(frame, params.get_enum("holes"));
+    if (!holes.empty()) {
+      Frame& f = own_frame(frame, out);
+      for (Pass& p : f.passes)
+        if (p.role != Role::SampleCount && p.role != Role::Alpha) pull_push_fill(p.image, holes, nthreads);
+      out.notes.push_back("filled " + std::to_string(std::count(holes.begin(), holes.end(), 0.0f)) +
+                          " unsampled pixels by pull-push");
+    }
+  }
+  // Albedo prefilter: every later use of the albedo pass sees the smoothed one.
+  if (steps.albedo_prefilter && params.get_float("albedo_prefilter") > 0) {
+    if (const Pass* a = out.frame->find(Role::Albedo)) {
+      AlbedoPrefilter ap;
+      ap.range_sigma = params.get_float("albedo_prefilter");
+      ap.position_sigma = params.get_float("albedo_prefilter_position");
+      // Albedo weights read it over the filter's whole reach: smooth the work region.
+      Image smooth = prefilter_albedo(*out.frame, *a, ap, work, nthreads);
+      const std::size_t index = std::size_t(a - out.frame->passes.data());
+      own_frame(frame, out).passes[index].image = std::move(smooth);
+    } else {
+      out.notes.push_back("albedo_prefilter skipped: no albedo pass in '" + frame.path + "'");
+    }
+  }
+  out.colour = rgb_copy(out.frame->image(Role::Colour), nthreads);
+  if (work.empty()) return;
+
+  // Albedo demodulation: filter the illumination, not the texture.
+  if (steps.demodulate && params.get_bool("demodulate")) {
+    const Pass* a = out.frame->find(Role::Albedo);
+    if (!a) throw Error(Errc::MissingPass, "demodulate=true needs the albedo pass, absent in '" + frame.path + "'");
+    out.divisor = Image(w, h, 3);
+    demodulate(a->image, float(params.get_float("albedo_floor")), demod_region, nthreads, out.divisor, out.colour);
+  }
+  // Firefly suppression, after demodulation: on the illumination a texture edge is not an
+  // outlier, and a firefly stands out of its window more clearly (glossy: 0.0099 -> 0.0090).
+  if (fireflies) {
+    const std::size_t clamped = clamp_fireflies(out.colour, int(params.get_int("firefly_radius")),
+                                                params.get_float("firefly_k"), work, nthreads);
+    out.notes.push_back("firefly suppression clamped " + std::to_string(clamped) + " pixels");
+  }
+  if (steps.outliers) clamp_channels(out.colour, params.get_float("clamp"), work, nthreads);
+}
+
+std::size_t finish(const Prepared& prepared, const Image& input, const Roi& roi, int nthreads, Image& out) {
+  const int w = out.width(), h = out.height();
+  const std::size_t rw = std::size_t(w) * 3;
+  const int ich = input.channels();
+  std::vector<std::size_t> row_repaired(std::size_t(std::max(h, 0)), 0);
+  parallel_rows(0, h, nthreads, [&](int y) {
+    float* o = out.data() + std::size_t(y) * rw;
+    const bool inside_rows = y >= roi.y0 && y < roi.y1;
+    // Outside the roi: the input colour, bit for bit.
+    const float* in = input.pixel(0, y);
+    for (int x = 0; x < w; ++x) {
+      if (inside_rows && x >= roi.x0 && x < roi.x1) {
+        x = roi.x1 - 1;
+        continue;
+      }
+      for (int c = 0; c < 3; ++c) o[std::size_t(x) * 3 + std::size_t(c)] = in[std::size_t(x) * std::size_t(ich) + std::size_t(c)];
+    }
+    if (inside_rows && !prepared.divisor.empty()) {
+      const float* al = prepared.divisor.pixel(roi.x0, y);
+      float* oo = o + std::size_t(roi.x0) * 3;
+      for (std::size_t i = 0, n = std::size_t(roi.width()) * 3; i < n; ++i) oo[i] *= al[i];
+    }
+    // Branch-free scan first: almost every row is finite.
+    bool all = true;
+    for (std::size_t i = 0; i < rw; ++i) all &= std::fabs(o[i]) <= 3.402823466e38f;
+    if (all) return;
+    std::size_t n = 0;
+    for (std::size_t i = 0; i < rw; ++i)
+      if (!std::isfinite(o[i])) { o[i] = 0.0f; ++n; }
+    row_repaired[std::size_t(y)] = n;
+  });
+  std::size_t repaired = 0;
+  for (std::size_t v : row_repaired) repaired += v;
+  return repaired;
+}
+
+}  // namespace mcr

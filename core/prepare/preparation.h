@@ -1,0 +1,67 @@
+#pragma once
+// The preparation steps the base class runs before a filter's run(), in this order:
+//   holes            pull-push fill of the unsampled pixels, every pass (thesis 5.1):
+//                    holes = auto (sample_count == 0 where that pass exists) | none |
+//                    sample_count | alpha (alpha == 0)
+//   albedo_prefilter the albedo pass smoothed before any use (prepare/albedo_prefilter.h):
+//                    albedo_prefilter (range sigma, 0 = off), albedo_prefilter_position
+//   demodulate       colour / albedo (prepare/demodulation.h), multiplied back after run():
+//                    demodulate, albedo_floor
+//   outliers         bright outliers clamped (prepare/outliers.h): firefly_k (0 = off),
+//                    firefly_radius; then every channel clamped to [-clamp, clamp] (0 = off)
+// A filter states which steps it takes (FilterInfo::steps); its parameter table gets the
+// parameters of those steps only, and no filter reads them: run() receives their result.
+// Each step works on the region the filter reads (the roi grown by its reach); outside
+// the roi the output is the input colour, bit for bit (non-finite values there become 0:
+// nothing non-finite leaves a filter).
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "image/pass.h"
+#include "util/params.h"
+
+namespace mcr {
+
+struct PrepSteps {
+  bool holes = true, albedo_prefilter = true, demodulate = true, outliers = true;
+  static PrepSteps none() { return {false, false, false, false}; }
+};
+
+// `own` followed by the parameters of the steps.
+ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps);
+
+// The passes the steps need under these settings (demodulate: albedo; holes=sample_count
+// / alpha: that pass) and those they use when present (albedo_prefilter: albedo, normal,
+// position; holes=auto: sample_count).
+// `why` gets, per required pass, the setting that needs it ("demodulate=true").
+void preparation_needs(const ParamSet& params, const PrepSteps& steps, std::vector<Role>& required,
+                       std::vector<std::string>& why, std::vector<Role>& optional);
+
+// "firefly_radius has no effect with firefly_k=0" for each setting given that changes
+// nothing under the others.
+std::vector<std::string> preparation_unused(const ParamSet& params, const PrepSteps& steps);
+
+// What run() reads.
+struct Prepared {
+  const Frame* frame = nullptr;  // every pass after the steps (the input itself when none changed one)
+  Image colour;                  // RGB: demodulated and outlier-clamped inside the work region
+  Image divisor;                 // the demodulation divisor (RGB); empty when not demodulated
+  std::vector<std::string> notes;
+  Frame own;                     // storage when a step changed a pass
+};
+
+// Runs the steps over `work` (clipped to the frame). Throws MissingPass naming the frame's
+// file for a pass a setting needs.
+void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps, const Roi& work, int nthreads,
+             Prepared& out);
+
+// After run() wrote `out` (RGB, the frame's size) inside roi: remodulated inside roi, the
+// input colour's RGB outside it, non-finite values replaced by 0 everywhere. Returns the
+// number of values replaced.
+std::size_t finish(const Prepared& prepared, const Image& input_colour, const Roi& roi, int nthreads, Image& out);
+
+// The RGB of `colour` as its own 3-channel image (row-parallel copy).
+Image rgb_copy(const Image& colour, int nthreads);
+
+}  // namespace mcr
