@@ -16,7 +16,7 @@
 #include "io/sample_manifest.h"
 #include "pipeline/evaluate.h"
 #include "sweeps.h"
-#include "temporal/accumulation.h"
+#include "pipeline/reconstruction.h"
 #include "util/error.h"
 #include "util/isa.h"
 
@@ -51,32 +51,14 @@ struct Fnv {
   }
 };
 
-// The RGB of a frame's colour pass replaced by `rgb` (alpha and other channels kept).
-mcr::Frame with_colour(const mcr::Frame& frame, const mcr::Image& rgb) {
-  mcr::Frame f = frame;
-  mcr::Pass colour = f.get(mcr::Role::Colour);
-  const int ch = colour.image.channels();
-  for (std::size_t i = 0; i < rgb.pixel_count(); ++i)
-    for (int c = 0; c < 3; ++c) colour.image.data()[i * std::size_t(ch) + std::size_t(c)] = rgb.data()[i * 3 + std::size_t(c)];
-  f.put(std::move(colour));
-  return f;
-}
-
-std::string hash_of(const mcr::LoadedScene& scene, mcr::Filter& filter, bool accumulate, int threads) {
-  filter.reset();
-  mcr::TemporalAccumulator acc;
+// The filter alone, or after the pipeline's accumulation stage (as --accumulate runs it).
+std::string hash_of(const mcr::LoadedScene& scene, std::unique_ptr<mcr::Filter> filter, bool accumulate, int threads) {
+  mcr::Reconstruction rec(std::move(filter), accumulate);
+  rec.reset();
   Fnv fnv;
   mcr::ExecOptions eo;
   eo.nthreads = threads;
-  for (const mcr::Frame& frame : scene.frames) {
-    if (accumulate) {
-      const mcr::Image& c = frame.image(mcr::Role::Colour);
-      const mcr::Image rgb = c.channels() == 3 ? c : c.channel_range(0, 3);
-      fnv.add(filter.execute(with_colour(frame, acc.accumulate(frame, rgb, threads)), eo));
-    } else {
-      fnv.add(filter.execute(frame, eo));
-    }
-  }
+  for (const mcr::Frame& frame : scene.frames) fnv.add(rec.run(frame, eo));
   char buf[32];
   std::snprintf(buf, sizeof buf, "%016llx", static_cast<unsigned long long>(fnv.h));
   return buf;
@@ -135,11 +117,14 @@ int main(int argc, char** argv) {
               filter->commit();
               if (!filter->missing_passes(loaded.frames.front()).empty()) break;
               if (setting.empty()) setting = "defaults";
+              auto twin = mcr::make_filter(name);  // the same settings, for the accumulated run
+              for (const auto& kv : filter->params().values()) twin->set(kv.first, kv.second);
+              twin->commit();
               std::printf("%s %s [%s] %s\n", scene.name.c_str(), name.c_str(), setting.c_str(),
-                          hash_of(loaded, *filter, false, threads).c_str());
+                          hash_of(loaded, std::move(filter), false, threads).c_str());
               if (scene.is_sequence() && !info.temporal)
                 std::printf("%s %s [accumulate %s] %s\n", scene.name.c_str(), name.c_str(), setting.c_str(),
-                            hash_of(loaded, *filter, true, threads).c_str());
+                            hash_of(loaded, std::move(twin), true, threads).c_str());
               std::fflush(stdout);
             }
           }

@@ -1,4 +1,4 @@
-#include <chrono>
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
@@ -9,7 +9,6 @@
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
 #include "progress.h"
-#include "temporal/accumulation.h"
 #include "util/error.h"
 
 namespace mcr::cli {
@@ -20,7 +19,7 @@ struct DenoiseArgs {
   std::string input, output, filter, layer, frames, region, compression = "zip";
   std::vector<std::string> sets, passes;
   bool keep_passes = false, timings = false, verbose = false, resume = false;
-  bool accumulate = false;  // BMFR phase I before the filter
+  bool accumulate = false;  // the accumulation stage before the filter
   int threads = 0;
 };
 
@@ -49,7 +48,7 @@ std::string times_text(const StageTimes& t) {
 int run_denoise(const DenoiseArgs& a) {
   std::vector<std::pair<std::string, std::string>> params;
   for (const auto& s : a.sets) params.push_back(parse_key_value(s, "--set"));
-  DenoiseSession session(a.filter, params);  // unknown filter / parameter errors first
+  DenoiseSession session(a.filter, params, a.accumulate);  // unknown filter / parameter errors first
 
   ReadOptions ro;
   ro.layer = a.layer;
@@ -97,38 +96,11 @@ int run_denoise(const DenoiseArgs& a) {
   for (const auto& j : jobs) outputs.push_back(j.second);
   check_output_paths(outputs, inputs);
 
-  const bool temporal = session.filter().info().temporal || a.accumulate;
-  // --accumulate: BMFR phase I (reprojected cumulative/exponential average of the noisy
-  // colour, own history across this run's frames) before the filter, which then sees a
-  // frame whose colour pass holds the accumulated RGB (alpha kept).
-  TemporalAccumulator accumulator;
-  auto run_accumulated = [&](const std::string& in, const std::string& out) {
-    using clock = std::chrono::steady_clock;
-    auto ms = [](clock::time_point t0) { return std::chrono::duration<double, std::milli>(clock::now() - t0).count(); };
-    StageTimes t;
-    auto t0 = clock::now();
-    Frame frame = read_frame(in, ro);
-    t.read_ms = ms(t0);
-    t0 = clock::now();
-    Pass colour = frame.get(Role::Colour);
-    const Image acc = accumulator.accumulate(frame, colour.image.channels() == 3 ? colour.image : colour.image.channel_range(0, 3), eo.nthreads);
-    for (std::size_t i = 0; i < acc.pixel_count(); ++i)
-      for (int c = 0; c < 3; ++c) colour.image.data()[i * std::size_t(colour.image.channels()) + std::size_t(c)] = acc.data()[i * 3 + std::size_t(c)];
-    frame.put(std::move(colour));
-    const Image result = session.filter().execute(frame, eo);
-    t.filter_ms = ms(t0);
-    if (!out.empty()) {
-      t0 = clock::now();
-      WriteOptions w = wo;
-      w.attributes.emplace_back("mcreconFilter", session.filter().info().name);
-      std::string params = "accumulate=true";
-      for (const auto& kv : session.filter().params().values()) params += " " + kv.first + "=" + param_value_text(kv.second);
-      w.attributes.emplace_back("mcreconParameters", params);
-      write_result(out, result, frame, w);
-      t.write_ms = ms(t0);
-    }
-    return t;
-  };
+  const bool temporal = session.reconstruction().temporal();
+  // Settings that change nothing: said once, not per frame.
+  const std::vector<std::string>& unused = session.filter().unused_settings();
+  if (a.verbose)
+    for (const auto& n : unused) std::cerr << "mcrecon: note: " << n << "\n";
   Progress progress("denoise " + a.filter, int(jobs.size()));
   StageTimes sum;
   int written = 0, skipped = 0;
@@ -142,14 +114,14 @@ int run_denoise(const DenoiseArgs& a) {
       continue;
     }
     // Temporal filters replay finished frames without writing, to warm up history.
-    const StageTimes t = a.accumulate ? run_accumulated(in, done ? std::string() : out)
-                                      : session.run(in, done ? std::string() : out, ro, wo, eo);
+    const StageTimes t = session.run(in, done ? std::string() : out, ro, wo, eo);
     sum.read_ms += t.read_ms;
     sum.filter_ms += t.filter_ms;
     sum.write_ms += t.write_ms;
     done ? ++skipped : ++written;
     if (a.verbose)
-      for (const auto& n : session.filter().notes()) std::cerr << "mcrecon: " << in << ": " << n << "\n";
+      for (const auto& n : session.reconstruction().notes())
+        if (std::find(unused.begin(), unused.end(), n) == unused.end()) std::cerr << "mcrecon: " << in << ": " << n << "\n";
     if (seq) progress.step(int(i + 1), (done ? "warm-up " + in : out) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
     else if (a.timings || a.verbose) std::cerr << "mcrecon: " << out << ": " << times_text(t) << "\n";
   }

@@ -85,7 +85,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     throw Error(Errc::MissingPass, "filter '" + info_.name + "' needs the " + names + " pass" + (count > 1 ? "es" : "") +
                                        ", absent in '" + frame.path + "'");
   frame.check_sizes();
-  notes_ = unused_;
+  notes_.clear();
   const int nthreads = options.nthreads;
   const int w = frame.width, h = frame.height;
   const Image& input = frame.image(Role::Colour);

@@ -72,8 +72,7 @@ class Filter {
   // Settings given that change nothing under the others (from commit()), e.g.
   // "firefly_radius has no effect with firefly_k=0".
   const std::vector<std::string>& unused_settings() const { return unused_; }
-  // Notes from the last execute() (which optional weights were dropped, ...), after the
-  // unused-setting notes.
+  // Notes from the last execute() (which optional weights were dropped, ...).
   const std::vector<std::string>& notes() const { return notes_; }
   // Non-finite values the safety net replaced in the last execute(); a correct
   // filter keeps this at 0 (tests check it).

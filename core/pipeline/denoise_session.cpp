@@ -2,7 +2,6 @@
 
 #include <chrono>
 
-#include "filters/registry.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -20,24 +19,9 @@ std::pair<std::string, std::string> parse_key_value(const std::string& text, con
   return {text.substr(0, eq), text.substr(eq + 1)};
 }
 
-std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
-                                              const std::vector<std::pair<std::string, std::string>>& params) {
-  std::unique_ptr<Filter> f = make_filter(filter);
-  for (const auto& kv : params) f->set_text(kv.first, kv.second);
-  f->commit();
-  return f;
-}
-
-std::string parameters_text(const Filter& filter) {
-  std::string params;
-  for (const auto& kv : filter.params().values())
-    params += (params.empty() ? "" : " ") + kv.first + "=" + param_value_text(kv.second);
-  return params;
-}
-
 DenoiseSession::DenoiseSession(const std::string& filter,
-                               const std::vector<std::pair<std::string, std::string>>& params)
-    : filter_(make_committed_filter(filter, params)) {}
+                               const std::vector<std::pair<std::string, std::string>>& params, bool accumulate)
+    : reconstruction_(make_committed_filter(filter, params), accumulate) {}
 
 StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
                                const WriteOptions& write, const ExecOptions& exec) {
@@ -47,14 +31,14 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
   t.read_ms = ms_since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const Image result = filter_->execute(frame, exec);
+  const Image result = reconstruction_.run(frame, exec);
   t.filter_ms = ms_since(t0);
 
   if (!output.empty()) {
     t0 = std::chrono::steady_clock::now();
     WriteOptions w = write;
-    w.attributes.emplace_back("mcreconFilter", filter_->info().name);
-    w.attributes.emplace_back("mcreconParameters", parameters_text(*filter_));
+    w.attributes.emplace_back("mcreconFilter", reconstruction_.filter().info().name);
+    w.attributes.emplace_back("mcreconParameters", reconstruction_.parameters_text());
     write_result(output, result, frame, w);
     t.write_ms = ms_since(t0);
   }

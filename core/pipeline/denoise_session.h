@@ -1,15 +1,15 @@
 #pragma once
-// The file pipeline shared by the front ends: read passes -> run filter -> write,
-// with per-stage timings. One session keeps one filter (and its temporal history)
-// across the frames of a sequence.
+// The file pipeline shared by the front ends: read passes -> reconstruction (optional
+// accumulation, the filter) -> write, with per-stage timings. One session keeps one
+// reconstruction (and its temporal history) across the frames of a sequence.
 #include <memory>
 #include <string>
 #include <utility>
 #include <vector>
 
-#include "filters/filter.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
+#include "pipeline/reconstruction.h"
 
 namespace mcr {
 
@@ -21,10 +21,13 @@ struct StageTimes {
 class DenoiseSession {
  public:
   // Makes the filter, sets every key=value (from its table) and commits: all
-  // parameter errors surface here, before any file is touched.
-  DenoiseSession(const std::string& filter, const std::vector<std::pair<std::string, std::string>>& params);
+  // parameter errors surface here, before any file is touched. accumulate: the
+  // temporal accumulation stage before the filter (pipeline/reconstruction.h).
+  DenoiseSession(const std::string& filter, const std::vector<std::pair<std::string, std::string>>& params,
+                 bool accumulate = false);
 
-  Filter& filter() { return *filter_; }
+  Filter& filter() { return reconstruction_.filter(); }
+  Reconstruction& reconstruction() { return reconstruction_; }
 
   // Reads input, filters, and writes output unless output is empty (warm-up of
   // temporal history on frames that already have an output).
@@ -32,17 +35,8 @@ class DenoiseSession {
                  const WriteOptions& write, const ExecOptions& exec);
 
  private:
-  std::unique_ptr<Filter> filter_;
+  Reconstruction reconstruction_;
 };
-
-// The filter made, every key=value set (from its table) and committed: what a
-// session starts with. For front ends that keep filters themselves (the OIIO plugin).
-std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
-                                              const std::vector<std::pair<std::string, std::string>>& params);
-
-// "radius=3 demodulate=false ...": every parameter value of the filter, as the
-// "mcreconParameters" header attribute of an output.
-std::string parameters_text(const Filter& filter);
 
 // "key=value" -> pair; throws InvalidArgument.
 std::pair<std::string, std::string> parse_key_value(const std::string& text, const std::string& option);

@@ -1,0 +1,82 @@
+#include "pipeline/reconstruction.h"
+
+#include "filters/registry.h"
+#include "util/error.h"
+
+namespace mcr {
+
+std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
+                                              const std::vector<std::pair<std::string, std::string>>& params) {
+  std::unique_ptr<Filter> f = make_filter(filter);
+  for (const auto& kv : params) f->set_text(kv.first, kv.second);
+  f->commit();
+  return f;
+}
+
+std::string parameters_text(const Filter& filter) {
+  std::string params;
+  for (const auto& kv : filter.params().values())
+    params += (params.empty() ? "" : " ") + kv.first + "=" + param_value_text(kv.second);
+  return params;
+}
+
+Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate)
+    : filter_(std::move(filter)), accumulate_(accumulate) {
+  if (!filter_) throw Error(Errc::Internal, "Reconstruction without a filter");
+}
+
+PassNeeds Reconstruction::needs() const {
+  PassNeeds n = filter_->needs();
+  if (accumulate_) {
+    n.require(Role::Position, "accumulate");
+    n.require(Role::Normal, "accumulate");
+    n.use(Role::Motion);
+  }
+  return n;
+}
+
+Image Reconstruction::run(const Frame& frame, const ExecOptions& options) {
+  notes_.clear();
+  if (!accumulate_) return filter_->execute(frame, options);
+  // Accumulation's passes first: nothing is accumulated for a frame the filter refuses.
+  const PassNeeds need = needs();
+  std::string names;
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < need.required.size(); ++i)
+    if (!frame.has(need.required[i]))
+      names += std::string(count++ ? ", " : "") + role_name(need.required[i]) +
+               (need.why[i].empty() ? "" : " (for " + need.why[i] + ")");
+  if (count)
+    throw Error(Errc::MissingPass, "filter '" + filter_->info().name + "' with accumulation needs the " + names +
+                                       " pass" + (count > 1 ? "es" : "") + ", absent in '" + frame.path + "'");
+  Frame accumulated = frame;
+  Pass colour = accumulated.get(Role::Colour);
+  const Image& in = colour.image;
+  const Image& acc = accumulator_.accumulate(frame, in.channels() == 3 ? in : in.channel_range(0, 3), options.nthreads);
+  const std::size_t ch = std::size_t(in.channels());
+  for (std::size_t i = 0; i < acc.pixel_count(); ++i)
+    for (std::size_t c = 0; c < 3; ++c) colour.image.data()[i * ch + c] = acc.data()[i * 3 + c];
+  accumulated.put(std::move(colour));
+  const Reprojection& rep = accumulator_.last_reprojection();
+  if (rep.cut) notes_.push_back("accumulation: camera cut, history restarted");
+  return filter_->execute(accumulated, options);
+}
+
+void Reconstruction::reset() {
+  accumulator_.reset();
+  filter_->reset();
+}
+
+std::vector<std::string> Reconstruction::notes() const {
+  std::vector<std::string> all = filter_->unused_settings();
+  all.insert(all.end(), filter_->notes().begin(), filter_->notes().end());
+  all.insert(all.end(), notes_.begin(), notes_.end());
+  return all;
+}
+
+std::string Reconstruction::parameters_text() const {
+  const std::string own = mcr::parameters_text(*filter_);
+  return accumulate_ ? "accumulate=true " + own : own;
+}
+
+}  // namespace mcr

@@ -1,0 +1,56 @@
+#pragma once
+// What every front end runs per frame (CLI, OIIO plugin, Python module, Blender add-on):
+// an optional temporal accumulation stage (BMFR phase I, Koskela et al. 2019, 4.1: the
+// reprojected cumulative-then-exponential average of the noisy colour, with its own
+// history across the frames of a run) before the filter, which then sees a frame whose
+// colour pass holds the accumulated RGB (alpha and other channels kept). Only the
+// pipeline combines stages; the filter knows nothing of it.
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "filters/filter.h"
+#include "temporal/accumulation.h"
+
+namespace mcr {
+
+class Reconstruction {
+ public:
+  Reconstruction(std::unique_ptr<Filter> filter, bool accumulate);
+
+  Filter& filter() { return *filter_; }
+  const Filter& filter() const { return *filter_; }
+  bool accumulates() const { return accumulate_; }
+  // Frame order matters (history between run() calls): a temporal filter, or accumulation.
+  bool temporal() const { return accumulate_ || filter_->info().temporal; }
+
+  // The filter's needs plus the accumulation's (world position and normal; motion used).
+  PassNeeds needs() const;
+
+  // Checks the passes (MissingPass naming the frame's file, before any work), accumulates
+  // when asked, runs the filter.
+  Image run(const Frame& frame, const ExecOptions& options = {});
+  // Drops the history of both stages (new shot, frames out of order).
+  void reset();
+
+  // The unused settings, then the notes of the last run() (the filter's, the accumulation's).
+  std::vector<std::string> notes() const;
+  // "accumulate=true radius=3 ...": every setting, as the mcreconParameters attribute.
+  std::string parameters_text() const;
+
+ private:
+  std::unique_ptr<Filter> filter_;
+  bool accumulate_ = false;
+  TemporalAccumulator accumulator_;
+  std::vector<std::string> notes_;
+};
+
+// The filter made, every key=value set (from its table) and committed: all parameter
+// errors surface here, before any file is touched.
+std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
+                                              const std::vector<std::pair<std::string, std::string>>& params);
+
+// "radius=3 demodulate=false ...": every parameter value of the filter.
+std::string parameters_text(const Filter& filter);
+
+}  // namespace mcr
