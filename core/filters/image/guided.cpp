@@ -8,75 +8,15 @@
 #include <cstring>
 #include <limits>
 
+#include "filters/image/guided_guides.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
 namespace mcr {
 
+using namespace guided;
+
 namespace {
-
-// ---------------------------------------------------------------------------
-// Guide choices: which passes, in which order, and how each pass is scaled.
-
-enum class Source { Normal, Depth, Position, Albedo, Luminance, Colour };
-
-struct GroupSpec {
-  Source source;
-  int channels;
-  bool unit;  // s = max(1, rms std) (unit quantities) instead of s = rms std
-};
-
-struct GuideChoice {
-  const char* name;
-  std::vector<GroupSpec> groups;
-};
-
-constexpr GroupSpec kNormal{Source::Normal, 3, true};
-constexpr GroupSpec kDepth{Source::Depth, 1, false};
-constexpr GroupSpec kPosition{Source::Position, 3, false};
-constexpr GroupSpec kAlbedo{Source::Albedo, 3, true};
-
-const std::vector<GuideChoice>& guide_choices() {
-  static const std::vector<GuideChoice> list = {
-      {"normal_depth", {kNormal, kDepth}},
-      {"normal", {kNormal}},
-      {"depth", {kDepth}},
-      {"position", {kPosition}},
-      {"normal_position", {kNormal, kPosition}},
-      {"albedo", {kAlbedo}},
-      {"normal_albedo", {kNormal, kAlbedo}},
-      {"normal_depth_albedo", {kNormal, kDepth, kAlbedo}},
-      {"luminance", {{Source::Luminance, 1, false}}},
-      {"colour", {{Source::Colour, 3, false}}},
-  };
-  return list;
-}
-
-std::vector<std::string> guide_names() {
-  std::vector<std::string> names;
-  for (const GuideChoice& g : guide_choices()) names.push_back(g.name);
-  return names;
-}
-
-const GuideChoice& find_choice(const std::string& name) {
-  for (const GuideChoice& g : guide_choices())
-    if (name == g.name) return g;
-  throw Error(Errc::BadParameterValue, "filter 'guided': unknown guide '" + name + "'");
-}
-
-Role source_role(Source s) {
-  switch (s) {
-    case Source::Normal: return Role::Normal;
-    case Source::Depth: return Role::Depth;
-    case Source::Position: return Role::Position;
-    case Source::Albedo: return Role::Albedo;
-    case Source::Luminance:
-    case Source::Colour: break;
-  }
-  return Role::Colour;
-}
-
-bool reads_pass(Source s) { return s != Source::Luminance && s != Source::Colour; }
 
 // ---------------------------------------------------------------------------
 // Per-pixel data the kernels read.
