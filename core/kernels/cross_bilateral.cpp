@@ -332,7 +332,7 @@ void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& 
 
 namespace {
 
-using namespace simd;  // Vec, splat, exp_neg_v (filters/simd_exp.h)
+using namespace simd;  // Vec, splat, exp_neg_v (kernels/fast_exp.h)
 
 template <int W>
 MCR_INLINE typename Vec<W>::f load_full(const float* row, int x) {

@@ -1,33 +1,170 @@
 // BMFR's last stage: temporal anti-aliasing (Karis 2014) of the phase III result.
 //
-// Layout: the result (res_) and the TAA history (taa_hist_) are planar RGB, so the
-// 3x3 statistics, the box and the clip run as straight loops over a row and the
-// Catmull-Rom lookup reads 4 contiguous floats per tap row and channel. Per row:
+// Layout: the result and the TAA history are planar RGB, so the 3x3 statistics, the box
+// and the clip run as straight loops over a row and the Catmull-Rom lookup reads 4
+// contiguous floats per tap row and channel. Per row:
 //   1. column statistics of rows y-1..y+1 in the clipping space (sum, sum of squares,
 //      min, max; border rows clamped, i.e. counted twice),
-//   2. the clipping box per pixel (3-wide sums of step 1; SSE),
+//   2. the clipping box per pixel (3-wide sums of step 1),
 //   3. the history lookup per pixel (Catmull-Rom or bilinear; the only gather),
 //   4. clip, blend, non-finite guard; written to the next history and to the output.
-// Every float operation is the one of the straightforward per-pixel form (same order for
-// the statistics, box and clip; the Catmull-Rom sum runs rows first: float rounding only).
+// One source for every vector width: the row is taa_row<W>, W float lanes of GCC vector
+// extensions (kernels/simd_lanes.h), built at the generic level with W = 4 and for AVX2
+// with W = 8 (util/isa.h); a row's last w % W pixels run the same code on a partly
+// filled vector. Every lane does
+// the float operations of the straightforward per-pixel form in its order (no FMA: the
+// core has -ffp-contract=off; min, max and clamp keep the operand order of the std::
+// forms, which decides what a NaN gives), so both builds give the same bits. Only the
+// Catmull-Rom sum departs from the per-pixel form (rows first: float rounding only).
+//
+// W-lane vectors pass between always-inlined helpers only: no ABI boundary.
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+#include "filters/temporal/bmfr_taa.h"
+
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "filters/temporal/bmfr.h"
-#include "filters/temporal/bmfr_taa_avx2.h"
-#include "filters/temporal/bmfr_taa_cr.h"
+#include "kernels/simd_lanes.h"
+#include "util/isa.h"
 #include "util/parallel.h"
-
-#if defined(__SSE2__)
-#include <emmintrin.h>
-#endif
 
 namespace mcr {
 
 namespace {
 
+using simd::for_lanes;
+using simd::load;
+using simd::store;
+using simd::vabs;
+using simd::vclamp;
+using simd::vmax;
+using simd::vmin;
+using simd::vsqrt;
+
 constexpr float kMax = std::numeric_limits<float>::max();
+
+// Shorthands, and the two helpers of the Catmull-Rom lookup that depend on the width.
+template <int W>
+using VF = typename simd::Vec<W>::f;
+template <int W>
+using VI = typename simd::Vec<W>::i;  // lane masks (-1 / 0) of comparisons
+using F4 = VF<4>;
+
+// The W / 4 groups of 4 lanes side by side, q[0] in the low lanes.
+template <int W>
+MCR_INLINE VF<W> join(const F4* q) {
+  if constexpr (W == 4) {
+    return q[0];
+  } else {
+    static_assert(W == 8, "4 or 8 lanes");
+    return __builtin_shufflevector(q[0], q[1], 0, 1, 2, 3, 4, 5, 6, 7);
+  }
+}
+
+// Lane 4p: (v[4p] + v[4p+1]) + (v[4p+2] + v[4p+3]), the sum of each group of 4.
+template <int W>
+MCR_INLINE VF<W> group_sums(VF<W> v) {
+  if constexpr (W == 4) {
+    const VF<W> s = v + __builtin_shufflevector(v, v, 1, 0, 3, 2);
+    return s + __builtin_shufflevector(s, s, 2, 3, 0, 1);
+  } else {
+    static_assert(W == 8, "4 or 8 lanes");
+    const VF<W> s = v + __builtin_shufflevector(v, v, 1, 0, 3, 2, 5, 4, 7, 6);
+    return s + __builtin_shufflevector(s, s, 2, 3, 0, 1, 6, 7, 4, 5);
+  }
+}
+
+// ---- the history lookups (scalar but for the interior Catmull-Rom taps) ----
+
+inline void cr_weights(float t, float* wt) {
+  const float t2 = t * t, t3 = t2 * t;
+  wt[0] = 0.5f * (-t3 + 2 * t2 - t);
+  wt[1] = 0.5f * (3 * t3 - 5 * t2 + 2);
+  wt[2] = 0.5f * (-3 * t3 + 4 * t2 + t);
+  wt[3] = 0.5f * (t3 - t2);
+}
+
+// The Catmull-Rom taps of one pixel's history sample (pixel centres at integers): none
+// when the sample lies outside the frame; interior when no tap needs clamping.
+struct CrTap {
+  int x;
+  bool ok, interior;
+  int bx, by;  // first tap
+  float wx[4], wy[4];
+};
+
+inline void cr_prepare(int w, int h, int x, float px, float py, bool inside, CrTap& t) {
+  t.x = x;
+  t.ok = t.interior = false;
+  if (!inside || !(px >= -0.5f && py >= -0.5f && px <= float(w) - 0.5f && py <= float(h) - 0.5f)) return;
+  t.ok = true;
+  const int ix = floor_int(px), iy = floor_int(py);
+  cr_weights(px - float(ix), t.wx);
+  cr_weights(py - float(iy), t.wy);
+  t.bx = ix - 1;
+  t.by = iy - 1;
+  t.interior = t.bx >= 0 && t.by >= 0 && t.bx + 3 < w && t.by + 3 < h;
+}
+
+// A sample near the border: taps clamped to it.
+inline void cr_clamped(const float* H, int w, int h, std::size_t n, const CrTap& t, float* out) {
+  int xs[4], ys[4];
+  for (int i = 0; i < 4; ++i) {
+    xs[i] = std::clamp(t.bx + i, 0, w - 1);
+    ys[i] = std::clamp(t.by + i, 0, h - 1);
+  }
+  for (int c = 0; c < 3; ++c) {
+    const float* p = H + std::size_t(c) * n;
+    float acc = 0;
+    for (int j = 0; j < 4; ++j) {
+      const float* row = p + std::size_t(ys[j]) * std::size_t(w);
+      float r = 0;
+      for (int i = 0; i < 4; ++i) r += t.wx[i] * row[xs[i]];
+      acc += t.wy[j] * r;
+    }
+    out[c] = acc;
+  }
+}
+
+// m <= W / 4 interior samples, 4 lanes each (lanes = tap columns): per channel the 4 tap
+// rows weighted by wy, times wx, summed per group. Groups past m repeat g[0], unstored.
+template <int W>
+MCR_INLINE void cr_interior(const float* H, int w, std::size_t n, const CrTap* g, int m, float* const hv[3],
+                            float* okr) {
+  constexpr int P = W / 4;
+  const CrTap* t[P];
+  const float* base[P];
+  for (int p = 0; p < P; ++p) {
+    t[p] = &g[p < m ? p : 0];
+    base[p] = H + std::size_t(t[p]->by) * std::size_t(w) + std::size_t(t[p]->bx);
+  }
+  F4 q[P];
+  VF<W> wy[4];
+  for (int j = 0; j < 4; ++j) {
+    for (int p = 0; p < P; ++p) q[p] = simd::splat<4>(t[p]->wy[j]);
+    wy[j] = join<W>(q);
+  }
+  for (int p = 0; p < P; ++p) q[p] = load<4>(t[p]->wx, 4);
+  const VF<W> wx = join<W>(q);
+  for (int c = 0; c < 3; ++c) {
+    const std::size_t plane = std::size_t(c) * n;
+    auto taps = [&](int j) __attribute__((always_inline)) {  // tap row j of every sample
+      const std::size_t o = plane + std::size_t(j) * std::size_t(w);
+      for (int p = 0; p < P; ++p) q[p] = load<4>(base[p] + o, 4);
+      return join<W>(q);
+    };
+    VF<W> s = wy[0] * taps(0);
+    for (int j = 1; j < 4; ++j) s = s + wy[j] * taps(j);
+    const VF<W> sum = group_sums<W>(s * wx);
+    for (int p = 0; p < m; ++p) hv[c][t[p]->x] = sum[4 * p];
+  }
+  for (int p = 0; p < m; ++p) okr[t[p]->x] = 1.0f;
+}
 
 // Bilinear sample of the planar history over the taps inside the frame, normalised by
 // their weights (Reprojection::sample on a planar image).
@@ -50,18 +187,20 @@ inline bool bilinear_planar(const Reprojection& rep, const float* hist, std::siz
   return true;
 }
 
+// ---- one row ----
+
 // Per-thread row scratch (grown once).
 struct TaaRow {
   std::vector<float> buf;
-  float* cs[3];
-  float* cq[3];
-  float* cmn[3];
-  float* cmx[3];
-  float* cur[3];
-  float* lo[3];
+  float* cs[3];   // column sums, one pixel of padding each side
+  float* cq[3];   // column sums of squares
+  float* cmn[3];  // column min
+  float* cmx[3];  // column max
+  float* cur[3];  // the centre row in the clipping space
+  float* lo[3];   // the clipping box
   float* hi[3];
-  float* hv[3];
-  float* ok;
+  float* hv[3];  // the history sample
+  float* ok;     // 1: the pixel has one
   void size(int w) {
     const std::size_t stride = (std::size_t(w) + 16) & ~std::size_t(7);
     if (buf.size() < stride * 25) buf.assign(stride * 25, 0.0f);
@@ -85,7 +224,196 @@ struct TaaRow {
   }
 };
 
+struct TaaJob {
+  TaaSettings s;
+  const Reprojection* rep;
+  int w, h;
+  std::size_t n;
+  const float* cur[3];  // the current frame's planes
+  const float* H;       // the history
+  float* next;
+  Image* out;
+  Roi roi;
+};
+
+// RGB -> YCoCg (Karis 2014): Y = r/4 + g/2 + b/4, Co = (r - b)/2, Cg = -r/4 + g/2 - b/4.
+template <class V>
+MCR_INLINE void to_ycocg(V r, V g, V b, V& y, V& co, V& cg) {
+  y = 0.25f * r + 0.5f * g + 0.25f * b;
+  co = 0.5f * r - 0.5f * b;
+  cg = -0.25f * r + 0.5f * g - 0.25f * b;
+}
+
+template <int W>
+MCR_INLINE void taa_row(const TaaJob& J, TaaRow& T, int y) {
+  using V = VF<W>;
+  const int w = J.w, h = J.h;
+  const bool ycocg = J.s.ycocg;
+  const std::size_t rb = std::size_t(y) * std::size_t(w);
+  // 1. Column statistics over rows y-1..y+1 (clamped), one pixel of padding each side.
+  // (The lambdas are always_inline: one compiled on its own would not get the AVX2
+  // target of taa_row_avx2.)
+  {
+    const std::size_t rows[3] = {std::size_t(std::max(0, y - 1)) * std::size_t(w), rb,
+                                 std::size_t(std::min(h - 1, y + 1)) * std::size_t(w)};
+    for_lanes<W>(w, [&](int x, int n) __attribute__((always_inline)) {
+      V v[3][3];  // channel, row
+      for (int j = 0; j < 3; ++j) {
+        const V r = load<W>(J.cur[0] + rows[j] + x, n), g = load<W>(J.cur[1] + rows[j] + x, n),
+                b = load<W>(J.cur[2] + rows[j] + x, n);
+        if (ycocg) {
+          to_ycocg(r, g, b, v[0][j], v[1][j], v[2][j]);
+        } else {
+          v[0][j] = r;
+          v[1][j] = g;
+          v[2][j] = b;
+        }
+      }
+      for (int k = 0; k < 3; ++k) {
+        const V v0 = v[k][0], v1 = v[k][1], v2 = v[k][2];
+        const int i = x + 1;
+        store<W>(T.cs[k] + i, v0 + v1 + v2, n);
+        store<W>(T.cq[k] + i, v0 * v0 + v1 * v1 + v2 * v2, n);
+        store<W>(T.cmn[k] + i, vmin(vmin(v2, v1), v0), n);  // std::min(v0, std::min(v1, v2))
+        store<W>(T.cmx[k] + i, vmax(vmax(v2, v1), v0), n);
+        store<W>(T.cur[k] + x, v1, n);
+      }
+    });
+    for (int k = 0; k < 3; ++k)
+      for (float* c : {T.cs[k], T.cq[k], T.cmn[k], T.cmx[k]}) {
+        c[0] = c[1];
+        c[w + 1] = c[w];
+      }
+  }
+  // 2. The clipping box: the 3x3 min/max, for ycocg intersected with mean +- gamma sd
+  // (each widened to hold the current pixel).
+  for (int k = 0; k < 3; ++k) {
+    const float *cs = T.cs[k], *cq = T.cq[k], *cmn = T.cmn[k], *cmx = T.cmx[k], *cur = T.cur[k];
+    for_lanes<W>(w, [&](int x, int n) __attribute__((always_inline)) {
+      auto sum3 = [&](const float* c) __attribute__((always_inline)) {
+        return load<W>(c + x, n) + load<W>(c + x + 1, n) + load<W>(c + x + 2, n);
+      };
+      V lo = vmin(vmin(load<W>(cmn + x + 2, n), load<W>(cmn + x + 1, n)), load<W>(cmn + x, n));
+      V hi = vmax(vmax(load<W>(cmx + x + 2, n), load<W>(cmx + x + 1, n)), load<W>(cmx + x, n));
+      if (ycocg) {
+        const V mean = sum3(cs) * (1.0f / 9.0f);
+        const V var = vmax(sum3(cq) * (1.0f / 9.0f) - mean * mean, simd::splat<W>(0.0f));  // std::max(0, t)
+        const V sd = J.s.gamma * vsqrt<W>(var);
+        const V c = load<W>(cur + x, n);
+        lo = vmax(vmin(c, mean - sd), lo);  // std::max(lo, std::min(mean - sd, cur))
+        hi = vmin(vmax(c, mean + sd), hi);  // std::min(hi, std::max(mean + sd, cur))
+      }
+      store<W>(T.lo[k] + x, lo, n);
+      store<W>(T.hi[k] + x, hi, n);
+    });
+  }
+  // 3. History lookup.
+  {
+    const Reprojection& rep = *J.rep;
+    if (J.s.catmull_rom) {
+      // Interior samples W / 4 at a time, in the order met.
+      constexpr int P = W / 4;
+      CrTap g[P];
+      int m = 0;
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = rb + std::size_t(x);
+        CrTap& t = g[m];
+        cr_prepare(w, h, x, rep.prev_x[i], rep.prev_y[i], rep.inside[i] != 0, t);
+        if (t.interior) {
+          if (++m == P) {
+            cr_interior<W>(J.H, w, J.n, g, P, T.hv, T.ok);
+            m = 0;
+          }
+          continue;
+        }
+        float hv[3] = {0, 0, 0};
+        if (t.ok) cr_clamped(J.H, w, h, J.n, t, hv);
+        for (int c = 0; c < 3; ++c) T.hv[c][x] = hv[c];
+        T.ok[x] = t.ok ? 1.0f : 0.0f;
+      }
+      if (m) cr_interior<W>(J.H, w, J.n, g, m, T.hv, T.ok);
+    } else {
+      for (int x = 0; x < w; ++x) {
+        float hv[3] = {0, 0, 0};
+        const bool ok = bilinear_planar(rep, J.H, J.n, rb + std::size_t(x), hv);
+        for (int c = 0; c < 3; ++c) T.hv[c][x] = hv[c];
+        T.ok[x] = ok ? 1.0f : 0.0f;
+      }
+    }
+  }
+  // 4. Clip, blend, guard.
+  float* nx[3] = {J.next + rb, J.next + J.n + rb, J.next + 2 * J.n + rb};
+  const V one = simd::splat<W>(1.0f), big = simd::splat<W>(kMax), zero = simd::splat<W>(0.0f);
+  for_lanes<W>(w, [&](int x, int n) __attribute__((always_inline)) {
+    V s[3], l[3], u[3];
+    for (int k = 0; k < 3; ++k) {
+      s[k] = load<W>(T.hv[k] + x, n);
+      l[k] = load<W>(T.lo[k] + x, n);
+      u[k] = load<W>(T.hi[k] + x, n);
+    }
+    if (ycocg) {
+      const V r = s[0], g = s[1], b = s[2];
+      to_ycocg(r, g, b, s[0], s[1], s[2]);
+      // Clip towards the box centre along the line to the history (Karis 2014): keeps
+      // the history's hue instead of moving each channel on its own. A channel whose
+      // box is flat (within float rounding of the luma) does not steer the clip: the
+      // final clamp handles it.
+      V c[3], d[3], e[3], a[3];
+      for (int k = 0; k < 3; ++k) {
+        c[k] = 0.5f * (l[k] + u[k]);
+        d[k] = s[k] - c[k];
+        e[k] = 0.5f * (u[k] - l[k]);
+        a[k] = vabs<W>(d[k]);
+      }
+      const V tol = 1e-5f * (vabs<W>(c[0]) + e[0]) + 1e-30f;
+      V ratio = one;
+      for (int k = 0; k < 3; ++k)  // std::max(ratio, q) = vmax(q, ratio)
+        ratio = ((e[k] > tol) & (a[k] > e[k])) ? vmax(a[k] / e[k], ratio) : ratio;
+      const VI<W> scale = (ratio > one) & (ratio <= big);
+      for (int k = 0; k < 3; ++k) s[k] = scale ? c[k] + d[k] / ratio : s[k];
+    }
+    for (int k = 0; k < 3; ++k) s[k] = vclamp(s[k], l[k], u[k]);
+    if (ycocg) {  // back to RGB: r = Y + Co - Cg, g = Y + Cg, b = Y - Co - Cg
+      const V t = s[0] - s[2];
+      const V r = t + s[1], g = s[0] + s[2], b = t - s[1];
+      s[0] = r;
+      s[1] = g;
+      s[2] = b;
+    }
+    const VI<W> ok = load<W>(T.ok + x, n) != zero;
+    for (int k = 0; k < 3; ++k) {
+      const V q = load<W>(J.cur[k] + rb + x, n);
+      const V o = s[k] + J.s.alpha * (q - s[k]);
+      store<W>(nx[k] + x, (ok & (vabs<W>(o) <= big)) ? o : q, n);
+    }
+  });
+  if (J.out && y >= J.roi.y0 && y < J.roi.y1) {
+    float* o = J.out->data() + rb * 3;
+    for (int x = J.roi.x0; x < J.roi.x1; ++x)
+      for (int c = 0; c < 3; ++c) o[std::size_t(x) * 3 + std::size_t(c)] = nx[c][x];
+  }
+}
+
+void taa_row_generic(const TaaJob& J, TaaRow& T, int y) { taa_row<4>(J, T, y); }
+MCR_TARGET_AVX2 void taa_row_avx2(const TaaJob& J, TaaRow& T, int y) { taa_row<8>(J, T, y); }
+
 }  // namespace
+
+void temporal_antialias(const TaaSettings& s, const Reprojection& rep, const float* current, const float* history,
+                        float* next, int nthreads, Image* out, const Roi& roi) {
+  const int w = rep.width, h = rep.height;
+  const std::size_t n = std::size_t(w) * std::size_t(h);
+  const TaaJob J{s, &rep, w, h, n, {current, current + n, current + 2 * n}, history, next, out, roi.clipped(w, h)};
+  const bool avx2 = isa_at_least(Isa::Avx2);
+  parallel_rows(0, h, nthreads, [&](int y) {
+    thread_local TaaRow T;
+    T.size(w);
+    if (avx2)
+      taa_row_avx2(J, T, y);
+    else
+      taa_row_generic(J, T, y);
+  });
+}
 
 // TAA (Karis 2014): the previous output reprojected by the motion pass (bilinear or
 // Catmull-Rom), clipped to the current result's 3x3 neighbourhood, blended with weight
@@ -101,342 +429,16 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
     // No usable history: the result is the output and the new history.
     write_planar_roi(res_.data(), n, w, roi, out, nthreads);
     std::swap(taa_hist_, res_);
-    taa_w_ = w;
-    taa_h_ = h;
-    return;
+  } else {
+    TaaSettings s;
+    s.alpha = float(params_.get_float("taa_alpha"));
+    s.catmull_rom = params_.get_enum("taa_history") == "catmull_rom";
+    s.ycocg = params_.get_enum("taa_clip") == "ycocg_variance";
+    s.gamma = float(params_.get_float("taa_gamma"));
+    taa_next_.resize(3 * n);
+    temporal_antialias(s, rep, res_.data(), taa_hist_.data(), taa_next_.data(), nthreads, &out, roi);
+    std::swap(taa_hist_, taa_next_);
   }
-  const float a = float(params_.get_float("taa_alpha"));
-  const bool cubic = params_.get_enum("taa_history") == "catmull_rom";
-  const bool ycocg = params_.get_enum("taa_clip") == "ycocg_variance";
-  const float gamma = float(params_.get_float("taa_gamma"));
-  taa_next_.resize(3 * n);
-  const float* R = res_.data();
-  const float* G = R + n;
-  const float* Bc = G + n;
-  const float* H = taa_hist_.data();
-  float* N = taa_next_.data();
-  const int ox0 = roi.x0, ox1 = roi.x1;
-  const bool avx2 = detail::taa_avx2_available();
-
-  parallel_rows(0, h, nthreads, [&](int y) {
-    thread_local TaaRow T;
-    T.size(w);
-    const std::size_t rb = std::size_t(y) * std::size_t(w);
-    // 1. Column statistics over rows y-1..y+1 (clamped), one pixel of padding each side.
-    {
-      const std::size_t r0 = std::size_t(std::max(0, y - 1)) * std::size_t(w), r1 = rb,
-                        r2 = std::size_t(std::min(h - 1, y + 1)) * std::size_t(w);
-      float* cs0 = T.cs[0] + 1; float* cs1 = T.cs[1] + 1; float* cs2 = T.cs[2] + 1;
-      float* cq0 = T.cq[0] + 1; float* cq1 = T.cq[1] + 1; float* cq2 = T.cq[2] + 1;
-      float* mn0 = T.cmn[0] + 1; float* mn1 = T.cmn[1] + 1; float* mn2 = T.cmn[2] + 1;
-      float* mx0 = T.cmx[0] + 1; float* mx1 = T.cmx[1] + 1; float* mx2 = T.cmx[2] + 1;
-      float* cu0 = T.cur[0]; float* cu1 = T.cur[1]; float* cu2 = T.cur[2];
-      auto column = [](float v0, float v1, float v2, float& s, float& q, float& mn, float& mx) {
-        s = v0 + v1 + v2;
-        q = v0 * v0 + v1 * v1 + v2 * v2;
-        mn = std::min(v0, std::min(v1, v2));
-        mx = std::max(v0, std::max(v1, v2));
-      };
-      int x = 0;
-      if (avx2) {
-        float* const s3[3] = {cs0, cs1, cs2};
-        float* const q3[3] = {cq0, cq1, cq2};
-        float* const n3[3] = {mn0, mn1, mn2};
-        float* const x3[3] = {mx0, mx1, mx2};
-        float* const u3[3] = {cu0, cu1, cu2};
-        x = detail::taa_stats_avx2(x, w, ycocg, R, G, Bc, r0, r1, r2, s3, q3, n3, x3, u3);
-      }
-#if defined(__SSE2__)
-      {
-        // std::min(v0, std::min(v1, v2)) = _mm_min_ps(_mm_min_ps(v2, v1), v0), same for max.
-        auto col4 = [](__m128 v0, __m128 v1, __m128 v2, float* s, float* q, float* mn, float* mx) {
-          _mm_storeu_ps(s, _mm_add_ps(_mm_add_ps(v0, v1), v2));
-          _mm_storeu_ps(q, _mm_add_ps(_mm_add_ps(_mm_mul_ps(v0, v0), _mm_mul_ps(v1, v1)), _mm_mul_ps(v2, v2)));
-          _mm_storeu_ps(mn, _mm_min_ps(_mm_min_ps(v2, v1), v0));
-          _mm_storeu_ps(mx, _mm_max_ps(_mm_max_ps(v2, v1), v0));
-        };
-        const __m128 q4 = _mm_set1_ps(0.25f), h2 = _mm_set1_ps(0.5f), mq4 = _mm_set1_ps(-0.25f);
-        for (; x + 4 <= w; x += 4) {
-          __m128 c0[3], c1[3], c2[3];
-          const std::size_t rr[3] = {r0 + std::size_t(x), r1 + std::size_t(x), r2 + std::size_t(x)};
-          for (int j = 0; j < 3; ++j) {
-            const __m128 r = _mm_loadu_ps(R + rr[j]), g = _mm_loadu_ps(G + rr[j]), b = _mm_loadu_ps(Bc + rr[j]);
-            if (ycocg) {
-              c0[j] = _mm_add_ps(_mm_add_ps(_mm_mul_ps(q4, r), _mm_mul_ps(h2, g)), _mm_mul_ps(q4, b));
-              c1[j] = _mm_sub_ps(_mm_mul_ps(h2, r), _mm_mul_ps(h2, b));
-              c2[j] = _mm_sub_ps(_mm_add_ps(_mm_mul_ps(mq4, r), _mm_mul_ps(h2, g)), _mm_mul_ps(q4, b));
-            } else {
-              c0[j] = r;
-              c1[j] = g;
-              c2[j] = b;
-            }
-          }
-          col4(c0[0], c0[1], c0[2], cs0 + x, cq0 + x, mn0 + x, mx0 + x);
-          col4(c1[0], c1[1], c1[2], cs1 + x, cq1 + x, mn1 + x, mx1 + x);
-          col4(c2[0], c2[1], c2[2], cs2 + x, cq2 + x, mn2 + x, mx2 + x);
-          _mm_storeu_ps(cu0 + x, c0[1]);
-          _mm_storeu_ps(cu1 + x, c1[1]);
-          _mm_storeu_ps(cu2 + x, c2[1]);
-        }
-      }
-#endif
-      if (ycocg) {
-        for (; x < w; ++x) {
-          float y3[3], o3[3], g3[3];
-          const std::size_t rr[3] = {r0 + std::size_t(x), r1 + std::size_t(x), r2 + std::size_t(x)};
-          for (int j = 0; j < 3; ++j) {
-            const float r = R[rr[j]], g = G[rr[j]], b = Bc[rr[j]];
-            y3[j] = 0.25f * r + 0.5f * g + 0.25f * b;
-            o3[j] = 0.5f * r - 0.5f * b;
-            g3[j] = -0.25f * r + 0.5f * g - 0.25f * b;
-          }
-          column(y3[0], y3[1], y3[2], cs0[x], cq0[x], mn0[x], mx0[x]);
-          column(o3[0], o3[1], o3[2], cs1[x], cq1[x], mn1[x], mx1[x]);
-          column(g3[0], g3[1], g3[2], cs2[x], cq2[x], mn2[x], mx2[x]);
-          cu0[x] = y3[1];
-          cu1[x] = o3[1];
-          cu2[x] = g3[1];
-        }
-      } else {
-        for (; x < w; ++x) {
-          const std::size_t i0 = r0 + std::size_t(x), i1 = r1 + std::size_t(x), i2 = r2 + std::size_t(x);
-          column(R[i0], R[i1], R[i2], cs0[x], cq0[x], mn0[x], mx0[x]);
-          column(G[i0], G[i1], G[i2], cs1[x], cq1[x], mn1[x], mx1[x]);
-          column(Bc[i0], Bc[i1], Bc[i2], cs2[x], cq2[x], mn2[x], mx2[x]);
-          cu0[x] = R[i1];
-          cu1[x] = G[i1];
-          cu2[x] = Bc[i1];
-        }
-      }
-      for (int k = 0; k < 3; ++k) {
-        float* arr[4] = {T.cs[k], T.cq[k], T.cmn[k], T.cmx[k]};
-        for (float* c : arr) {
-          c[0] = c[1];
-          c[w + 1] = c[w];
-        }
-      }
-    }
-    // 2. The clipping box. std::min(a, b) is (b < a ? b : a) = _mm_min_ps(b, a), and
-    // std::max(a, b) is (a < b ? b : a) = _mm_max_ps(b, a): the same NaN behaviour.
-    for (int k = 0; k < 3; ++k) {
-      const float* cs = T.cs[k];
-      const float* cq = T.cq[k];
-      const float* cmn = T.cmn[k];
-      const float* cmx = T.cmx[k];
-      const float* cur = T.cur[k];
-      float* blo = T.lo[k];
-      float* bhi = T.hi[k];
-      int x = avx2 ? detail::taa_box_avx2(0, w, ycocg, gamma, cs, cq, cmn, cmx, cur, blo, bhi) : 0;
-#if defined(__SSE2__)
-      const __m128 ninth = _mm_set1_ps(1.0f / 9.0f), g4 = _mm_set1_ps(gamma), zero = _mm_setzero_ps();
-      for (; x + 4 <= w; x += 4) {
-        const __m128 mn0 = _mm_loadu_ps(cmn + x), mn1 = _mm_loadu_ps(cmn + x + 1), mn2 = _mm_loadu_ps(cmn + x + 2);
-        const __m128 mx0 = _mm_loadu_ps(cmx + x), mx1 = _mm_loadu_ps(cmx + x + 1), mx2 = _mm_loadu_ps(cmx + x + 2);
-        __m128 lo = _mm_min_ps(_mm_min_ps(mn2, mn1), mn0);  // std::min(mn0, std::min(mn1, mn2))
-        __m128 hi = _mm_max_ps(_mm_max_ps(mx2, mx1), mx0);
-        if (ycocg) {
-          const __m128 mean =
-              _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_loadu_ps(cs + x), _mm_loadu_ps(cs + x + 1)), _mm_loadu_ps(cs + x + 2)), ninth);
-          const __m128 m2 =
-              _mm_mul_ps(_mm_add_ps(_mm_add_ps(_mm_loadu_ps(cq + x), _mm_loadu_ps(cq + x + 1)), _mm_loadu_ps(cq + x + 2)), ninth);
-          const __m128 var = _mm_max_ps(_mm_sub_ps(m2, _mm_mul_ps(mean, mean)), zero);  // std::max(0, t)
-          const __m128 sd = _mm_mul_ps(g4, _mm_sqrt_ps(var));
-          const __m128 c = _mm_loadu_ps(cur + x);
-          lo = _mm_max_ps(_mm_min_ps(c, _mm_sub_ps(mean, sd)), lo);  // std::max(lo, std::min(mean - sd, cur))
-          hi = _mm_min_ps(_mm_max_ps(c, _mm_add_ps(mean, sd)), hi);  // std::min(hi, std::max(mean + sd, cur))
-        }
-        _mm_storeu_ps(blo + x, lo);
-        _mm_storeu_ps(bhi + x, hi);
-      }
-#endif
-      for (; x < w; ++x) {
-        float lo = std::min(cmn[x], std::min(cmn[x + 1], cmn[x + 2]));
-        float hi = std::max(cmx[x], std::max(cmx[x + 1], cmx[x + 2]));
-        if (ycocg) {
-          const float mean = (cs[x] + cs[x + 1] + cs[x + 2]) * (1.0f / 9.0f);
-          const float var = std::max(0.0f, (cq[x] + cq[x + 1] + cq[x + 2]) * (1.0f / 9.0f) - mean * mean);
-          const float sd = gamma * std::sqrt(var);
-          lo = std::max(lo, std::min(mean - sd, cur[x]));
-          hi = std::min(hi, std::max(mean + sd, cur[x]));
-        }
-        blo[x] = lo;
-        bhi[x] = hi;
-      }
-    }
-    // 3. History lookup.
-    {
-      float* h0 = T.hv[0];
-      float* h1 = T.hv[1];
-      float* h2 = T.hv[2];
-      float* okr = T.ok;
-      if (cubic && avx2) {
-        detail::taa_lookup_cr_avx2(w, h, n, H, rep.prev_x.data() + rb, rep.prev_y.data() + rb, rep.inside.data() + rb, h0,
-                                   h1, h2, okr);
-      } else {
-        for (int x = 0; x < w; ++x) {
-          const std::size_t i = rb + std::size_t(x);
-          float hv[3] = {0, 0, 0};
-          bool ok;
-          if (cubic)
-            ok = rep.inside[i] && catmull_rom_planar(H, w, h, n, rep.prev_x[i], rep.prev_y[i], hv);
-          else
-            ok = bilinear_planar(rep, H, n, i, hv);
-          h0[x] = hv[0];
-          h1[x] = hv[1];
-          h2[x] = hv[2];
-          okr[x] = ok ? 1.0f : 0.0f;
-        }
-      }
-    }
-    // 4. Clip, blend, guard (branch-free: vectorised).
-    {
-      const float* h0 = T.hv[0];
-      const float* h1 = T.hv[1];
-      const float* h2 = T.hv[2];
-      const float* h2_ = h2;
-      const float* okr = T.ok;
-      const float *lo0 = T.lo[0], *lo1 = T.lo[1], *lo2 = T.lo[2];
-      const float *hi0 = T.hi[0], *hi1 = T.hi[1], *hi2 = T.hi[2];
-      const float* cr = R + rb;
-      const float* cg = G + rb;
-      const float* cb = Bc + rb;
-      float* nr = N + rb;
-      float* ng = nr + n;
-      float* nb = ng + n;
-      int x = 0;
-      if (avx2) {
-        const float* const hv3[3] = {h0, h1, h2};
-        const float* const lo3[3] = {lo0, lo1, lo2};
-        const float* const hi3[3] = {hi0, hi1, hi2};
-        x = detail::taa_clip_avx2(x, w, ycocg, a, hv3, okr, lo3, hi3, cr, cg, cb, nr, ng, nb);
-      }
-#if defined(__SSE2__)
-      {
-        const __m128 q4 = _mm_set1_ps(0.25f), h2 = _mm_set1_ps(0.5f), mq4 = _mm_set1_ps(-0.25f);
-        const __m128 one = _mm_set1_ps(1.0f), big = _mm_set1_ps(kMax), sign = _mm_set1_ps(-0.0f), zero = _mm_setzero_ps();
-        const __m128 t5 = _mm_set1_ps(1e-5f), t30 = _mm_set1_ps(1e-30f), av = _mm_set1_ps(a);
-        auto sel = [](__m128 m, __m128 t, __m128 f) { return _mm_or_ps(_mm_and_ps(m, t), _mm_andnot_ps(m, f)); };
-        auto fabs4 = [&](__m128 v) { return _mm_andnot_ps(sign, v); };
-        // std::clamp(v, lo, hi) = v < lo ? lo : (hi < v ? hi : v)
-        auto clamp4 = [&](__m128 v, __m128 lo, __m128 hi) {
-          return sel(_mm_cmplt_ps(v, lo), lo, sel(_mm_cmplt_ps(hi, v), hi, v));
-        };
-        for (; x + 4 <= w; x += 4) {
-          const __m128 v0 = _mm_loadu_ps(h0 + x), v1 = _mm_loadu_ps(h1 + x), v2 = _mm_loadu_ps(h2_ + x);
-          const __m128 l0 = _mm_loadu_ps(lo0 + x), l1 = _mm_loadu_ps(lo1 + x), l2 = _mm_loadu_ps(lo2 + x);
-          const __m128 u0 = _mm_loadu_ps(hi0 + x), u1 = _mm_loadu_ps(hi1 + x), u2 = _mm_loadu_ps(hi2 + x);
-          __m128 s0, s1, s2;
-          if (ycocg) {
-            s0 = _mm_add_ps(_mm_add_ps(_mm_mul_ps(q4, v0), _mm_mul_ps(h2, v1)), _mm_mul_ps(q4, v2));
-            s1 = _mm_sub_ps(_mm_mul_ps(h2, v0), _mm_mul_ps(h2, v2));
-            s2 = _mm_sub_ps(_mm_add_ps(_mm_mul_ps(mq4, v0), _mm_mul_ps(h2, v1)), _mm_mul_ps(q4, v2));
-            const __m128 c0 = _mm_mul_ps(h2, _mm_add_ps(l0, u0)), c1 = _mm_mul_ps(h2, _mm_add_ps(l1, u1)),
-                         c2 = _mm_mul_ps(h2, _mm_add_ps(l2, u2));
-            const __m128 d0 = _mm_sub_ps(s0, c0), d1 = _mm_sub_ps(s1, c1), d2 = _mm_sub_ps(s2, c2);
-            const __m128 e0 = _mm_mul_ps(h2, _mm_sub_ps(u0, l0)), e1 = _mm_mul_ps(h2, _mm_sub_ps(u1, l1)),
-                         e2 = _mm_mul_ps(h2, _mm_sub_ps(u2, l2));
-            const __m128 tol = _mm_add_ps(_mm_mul_ps(t5, _mm_add_ps(fabs4(c0), e0)), t30);
-            const __m128 a0 = fabs4(d0), a1 = fabs4(d1), a2 = fabs4(d2);
-            __m128 ratio = one;
-            // std::max(ratio, q) = _mm_max_ps(q, ratio)
-            ratio = sel(_mm_and_ps(_mm_cmpgt_ps(e0, tol), _mm_cmpgt_ps(a0, e0)), _mm_max_ps(_mm_div_ps(a0, e0), ratio), ratio);
-            ratio = sel(_mm_and_ps(_mm_cmpgt_ps(e1, tol), _mm_cmpgt_ps(a1, e1)), _mm_max_ps(_mm_div_ps(a1, e1), ratio), ratio);
-            ratio = sel(_mm_and_ps(_mm_cmpgt_ps(e2, tol), _mm_cmpgt_ps(a2, e2)), _mm_max_ps(_mm_div_ps(a2, e2), ratio), ratio);
-            const __m128 scale = _mm_and_ps(_mm_cmpgt_ps(ratio, one), _mm_cmple_ps(ratio, big));
-            s0 = sel(scale, _mm_add_ps(c0, _mm_div_ps(d0, ratio)), s0);
-            s1 = sel(scale, _mm_add_ps(c1, _mm_div_ps(d1, ratio)), s1);
-            s2 = sel(scale, _mm_add_ps(c2, _mm_div_ps(d2, ratio)), s2);
-          } else {
-            s0 = v0;
-            s1 = v1;
-            s2 = v2;
-          }
-          s0 = clamp4(s0, l0, u0);
-          s1 = clamp4(s1, l1, u1);
-          s2 = clamp4(s2, l2, u2);
-          __m128 k0, k1, k2;
-          if (ycocg) {
-            const __m128 t = _mm_sub_ps(s0, s2);
-            k0 = _mm_add_ps(t, s1);
-            k1 = _mm_add_ps(s0, s2);
-            k2 = _mm_sub_ps(t, s1);
-          } else {
-            k0 = s0;
-            k1 = s1;
-            k2 = s2;
-          }
-          const __m128 ok = _mm_cmpneq_ps(_mm_loadu_ps(okr + x), zero);
-          const __m128 q0 = _mm_loadu_ps(cr + x), q1 = _mm_loadu_ps(cg + x), q2 = _mm_loadu_ps(cb + x);
-          const __m128 o0 = _mm_add_ps(k0, _mm_mul_ps(av, _mm_sub_ps(q0, k0)));
-          const __m128 o1 = _mm_add_ps(k1, _mm_mul_ps(av, _mm_sub_ps(q1, k1)));
-          const __m128 o2 = _mm_add_ps(k2, _mm_mul_ps(av, _mm_sub_ps(q2, k2)));
-          _mm_storeu_ps(nr + x, sel(_mm_and_ps(ok, _mm_cmple_ps(fabs4(o0), big)), o0, q0));
-          _mm_storeu_ps(ng + x, sel(_mm_and_ps(ok, _mm_cmple_ps(fabs4(o1), big)), o1, q1));
-          _mm_storeu_ps(nb + x, sel(_mm_and_ps(ok, _mm_cmple_ps(fabs4(o2), big)), o2, q2));
-        }
-      }
-#endif
-      for (; x < w; ++x) {
-        float hs0, hs1, hs2;
-        if (ycocg) {
-          hs0 = 0.25f * h0[x] + 0.5f * h1[x] + 0.25f * h2[x];
-          hs1 = 0.5f * h0[x] - 0.5f * h2[x];
-          hs2 = -0.25f * h0[x] + 0.5f * h1[x] - 0.25f * h2[x];
-          // Clip towards the box centre along the line to the history (Karis 2014):
-          // keeps the history's hue instead of moving each channel on its own. A channel
-          // whose box is flat (within float rounding of the luma) does not steer the
-          // clip: the final clamp handles it.
-          const float c0 = 0.5f * (lo0[x] + hi0[x]), c1 = 0.5f * (lo1[x] + hi1[x]), c2 = 0.5f * (lo2[x] + hi2[x]);
-          const float d0 = hs0 - c0, d1 = hs1 - c1, d2 = hs2 - c2;
-          const float e0 = 0.5f * (hi0[x] - lo0[x]), e1 = 0.5f * (hi1[x] - lo1[x]), e2 = 0.5f * (hi2[x] - lo2[x]);
-          const float tol = 1e-5f * (std::fabs(c0) + e0) + 1e-30f;
-          float ratio = 1.0f;
-          const float a0 = std::fabs(d0), a1 = std::fabs(d1), a2 = std::fabs(d2);
-          const float q0 = a0 / e0, q1 = a1 / e1, q2 = a2 / e2;
-          ratio = (e0 > tol && a0 > e0) ? std::max(ratio, q0) : ratio;
-          ratio = (e1 > tol && a1 > e1) ? std::max(ratio, q1) : ratio;
-          ratio = (e2 > tol && a2 > e2) ? std::max(ratio, q2) : ratio;
-          const bool scale = ratio > 1.0f && ratio <= kMax;
-          const float t0 = c0 + d0 / ratio, t1 = c1 + d1 / ratio, t2 = c2 + d2 / ratio;
-          hs0 = scale ? t0 : hs0;
-          hs1 = scale ? t1 : hs1;
-          hs2 = scale ? t2 : hs2;
-        } else {
-          hs0 = h0[x];
-          hs1 = h1[x];
-          hs2 = h2[x];
-        }
-        hs0 = std::clamp(hs0, lo0[x], hi0[x]);
-        hs1 = std::clamp(hs1, lo1[x], hi1[x]);
-        hs2 = std::clamp(hs2, lo2[x], hi2[x]);
-        float hc0, hc1, hc2;
-        if (ycocg) {
-          const float t = hs0 - hs2;
-          hc0 = t + hs1;
-          hc1 = hs0 + hs2;
-          hc2 = t - hs1;
-        } else {
-          hc0 = hs0;
-          hc1 = hs1;
-          hc2 = hs2;
-        }
-        const float v0 = hc0 + a * (cr[x] - hc0), v1 = hc1 + a * (cg[x] - hc1), v2 = hc2 + a * (cb[x] - hc2);
-        const bool ok = okr[x] != 0.0f;
-        nr[x] = ok && std::fabs(v0) <= kMax ? v0 : cr[x];
-        ng[x] = ok && std::fabs(v1) <= kMax ? v1 : cg[x];
-        nb[x] = ok && std::fabs(v2) <= kMax ? v2 : cb[x];
-      }
-      if (y >= roi.y0 && y < roi.y1) {
-        float* o = out.data() + rb * 3;
-        for (int x = ox0; x < ox1; ++x) {
-          o[std::size_t(x) * 3] = nr[x];
-          o[std::size_t(x) * 3 + 1] = ng[x];
-          o[std::size_t(x) * 3 + 2] = nb[x];
-        }
-      }
-    }
-  });
-  std::swap(taa_hist_, taa_next_);
   taa_w_ = w;
   taa_h_ = h;
 }
