@@ -7,6 +7,7 @@
 #include <cfloat>
 #include <cmath>
 
+#include "bilateral_reference.h"
 #include "feature_filter_testutil.h"
 #include "filters/image/bilateral.h"
 #include "kernels/cross_bilateral.h"
@@ -24,11 +25,12 @@ Params regression_params() {
 }
 
 // The header's definition in double: weights from the features and the order-0
-// result (the guide), regressors scaled by sqrt(k_f), ridge lambda * sum w.
+// result (the guide, from the brute-force order-0 reference, not from the filter under
+// test), regressors scaled by sqrt(k_f), ridge lambda * sum w.
 Image oracle(const Frame& frame, const Params& p) {
   Params p0 = p;
   p0["order"] = int64_t(0);
-  const Image guide = run_filter<BilateralFilter>(frame, p0).out;
+  const Image guide = bilateral_reference(frame, p0);
   BilateralFilter probe;
   for (const auto& [k, v] : p) probe.set(k, v);
   const ParamSet& ps = probe.params();
