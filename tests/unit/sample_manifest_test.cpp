@@ -90,8 +90,8 @@ TEST(SampleManifest, LoadSceneReadsTheNamedRendersInFrameOrder) {
   write_flat_exr(dir.path("wall/wall_16spp.exr"), 6, 4, 0.5f);
   write_flat_exr(dir.path("wall/wall_ref.exr"), 6, 4, 0.25f);
   for (int f = 3; f <= 5; ++f) {
-    write_flat_exr(sequence_path(scenes[1].noisy.at(2), f), 5, 3, float(f));
-    write_flat_exr(sequence_path(scenes[1].reference, f), 5, 3, float(10 * f));
+    write_flat_exr(sequence_path(dir.path("pan/pan_2spp_####.exr"), f), 5, 3, float(f));
+    write_flat_exr(sequence_path(dir.path("pan/pan_ref_####.exr"), f), 5, 3, float(10 * f));
   }
   const LoadedScene wall = load_scene(scenes[0], 16);
   EXPECT_EQ(wall.name, "wall");
