@@ -70,9 +70,39 @@ def relmse(x, ref):
     return float(np.mean((x - ref) ** 2 / (ref ** 2 + 1e-2)))
 
 
-def check_render(filter_name):
-    if filter_name not in mcrecon.filter_names():
-        skip(f"filter '{filter_name}' is not registered")
+def cli():
+    """This build's mcrecon CLI: $MCRECON_BIN, else bin/mcrecon beside <build>/mcrecon_addon.zip."""
+    path = os.environ.get("MCRECON_BIN") or os.path.join(os.path.dirname(os.environ["MCRECON_ADDON_ZIP"]),
+                                                         "bin", "mcrecon")
+    assert os.access(path, os.X_OK), f"no mcrecon CLI at {path} (set MCRECON_BIN)"
+    return path
+
+
+def cli_denoise(src, out, filter_name, *sets):
+    """`mcrecon denoise` on a saved render, reading the view layer the add-on reads."""
+    args = [cli(), "denoise", src, "-o", out, "-f", filter_name, "--layer", "ViewLayer"]
+    for s in sets:
+        args += ["--set", s]
+    p = subprocess.run(args, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, f"{' '.join(args)} exited {p.returncode}:\n{p.stderr}"
+    return out
+
+
+def all_channels(path):
+    inp = oiio.ImageInput.open(path)
+    assert inp, f"cannot open {path}: {oiio.geterror()}"
+    names = list(inp.spec().channelnames)
+    px = np.ascontiguousarray(inp.read_image(0, 0, 0, len(names), "float"), dtype=np.float32)
+    inp.close()
+    return names, px
+
+
+def check_render(filter_name, box_radius=None):
+    """The add-on's output is `mcrecon denoise` of the saved render with the scene's (default)
+    settings, bit for bit, and closer to a 256-spp render of the same scene than the noisy one.
+    With box_radius (an edge-aware filter): at least twice as close, and clearly closer than a
+    plain box blur of that radius, which a filter that only blurs would not be."""
+    assert filter_name in mcrecon.filter_names(), f"filter '{filter_name}' is not registered"
     r, log = run_blender()
     assert r["cycles_denoising"] is False, "the add-on did not turn Cycles denoising off"
     assert "turned off Cycles denoising" in log
@@ -81,10 +111,28 @@ def check_render(filter_name):
     for p in (noisy, ref, den):
         assert os.path.exists(p), f"missing {p}\n{log[-3000:]}"
     assert r["result_image"] and os.path.samefile(r["result_image"], den), r["result_image"]
+    want = cli_denoise(noisy, os.path.join(OUT, "cli_denoised.exr"), filter_name)
+    (got_names, got), (want_names, want_px) = all_channels(den), all_channels(want)
+    assert got_names == want_names, (got_names, want_names)
+    assert np.array_equal(got.view(np.uint32), want_px.view(np.uint32)), \
+        f"the add-on's output differs from `mcrecon denoise -f {filter_name}` on the saved render " \
+        f"(max |d| {np.abs(got - want_px).max()})"
     e_noisy, e_den = relmse(rgb(noisy), rgb(ref)), relmse(rgb(den), rgb(ref))
     print(f"{filter_name}: relMSE noisy {e_noisy:.5f}, denoised {e_den:.5f} "
           f"(render 16 spp {r['noisy_seconds']:.1f} s, reference 256 spp {r['ref_seconds']:.1f} s)")
     assert e_den < e_noisy, "the denoised render is not closer to the reference than the noisy one"
+    if box_radius is not None:
+        assert e_den < 0.5 * e_noisy, "the denoised render is not twice as close to the reference as the noisy one"
+        blur = cli_denoise(noisy, os.path.join(OUT, "box.exr"), "box", f"radius={box_radius}")
+        e_box = relmse(rgb(blur), rgb(ref))
+        print(f"{filter_name}: relMSE of a box blur of radius {box_radius}: {e_box:.5f}")
+        assert e_den < 0.8 * e_box, f"{filter_name} is not clearly better than a box blur of its radius"
+
+
+def bilateral_radius():
+    """The window radius of bilateral's default settings: ceil(3 spatial_sigma)."""
+    sigma = {p["name"]: p for p in mcrecon.filter_info("bilateral")["parameters"]}["spatial_sigma"]["default"]
+    return int(np.ceil(3 * sigma - 1e-6))
 
 
 def check_passes():
@@ -169,7 +217,8 @@ def check_install_zip():
     print(f"installed from the zip into {scripts}; native module {os.path.basename(r['native_file'])}")
 
 
-{"render_box": lambda: check_render("box"), "render_bilateral": lambda: check_render("bilateral"),
+{"render_box": lambda: check_render("box"),
+ "render_bilateral": lambda: check_render("bilateral", box_radius=bilateral_radius()),
  "passes": check_passes, "anim_bmfr": check_anim, "errors": check_errors,
  "composite": check_composite, "install_zip": check_install_zip}[CASE]()
 print("OK")

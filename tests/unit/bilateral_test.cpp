@@ -1,6 +1,5 @@
-// Cross-bilateral filter against a brute-force double-precision reference of
-//   w(p,q) = exp(-|q-p|^2/(2 s^2)) prod_f exp(-|f(p)-f(q)|^2/(2 sigma_f^2))
-// with the documented non-finite policy, plus closed forms and stress cases.
+// Cross-bilateral filter against a brute-force double-precision reference
+// (bilateral_reference.h), plus closed forms and stress cases.
 #include "filters/image/bilateral.h"
 
 #include <gtest/gtest.h>
@@ -14,6 +13,7 @@
 
 #include "kernels/cross_bilateral.h"
 #include "kernels/foveation.h"
+#include "bilateral_reference.h"
 #include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
@@ -40,65 +40,6 @@ double changed(const Image& out, const Image& in) {
   std::size_t n = 0;
   for (std::size_t i = 0; i < out.storage().size(); ++i) n += std::fabs(out.storage()[i] - in.storage()[i]) > 1e-3f;
   return double(n) / double(out.storage().size());
-}
-
-bool finite_n(const float* p, int n) {
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(p[i])) return false;
-  return true;
-}
-
-// Reference: the filter's documented definition, in double, straight loops.
-Image reference(const Frame& frame, const Params& given) {
-  BilateralFilter probe;
-  for (const auto& [k, v] : given) probe.set(k, v);
-  const ParamSet& ps = probe.params();
-  const int w = frame.width, h = frame.height;
-  const double ss = ps.get_float("spatial_sigma");
-  const int fixed = int(ps.get_int("radius"));
-  const int r = ss > 0 ? (fixed > 0 ? fixed : int(std::ceil(3 * ss - 1e-6))) : 0;
-  struct F {
-    const Image* im;
-    int ch;
-    double k;
-  };
-  std::vector<F> feats;
-  const Image& colour = frame.image(Role::Colour);
-  for (int i = 0; i < 5; ++i) {
-    const std::string n = kFeatureNames[i];
-    if (ps.get_enum("use_" + n) == "off" || !frame.has(kFeatureRoles[i])) continue;
-    const double s = ps.get_float(n + "_sigma");
-    feats.push_back({&frame.image(kFeatureRoles[i]), i == 4 ? 1 : 3, 1.0 / (2 * s * s)});
-  }
-  Image out(w, h, 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      double s[3] = {0, 0, 0}, sw = 0;
-      for (int qy = std::max(0, y - r); qy <= std::min(h - 1, y + r); ++qy)
-        for (int qx = std::max(0, x - r); qx <= std::min(w - 1, x + r); ++qx) {
-          const float* cq = colour.pixel(qx, qy);
-          bool usable = finite_n(cq, 3);
-          for (const F& f : feats) usable = usable && finite_n(f.im->pixel(qx, qy), f.ch);
-          if (!usable) continue;
-          const double d2 = double(qx - x) * (qx - x) + double(qy - y) * (qy - y);
-          double e = ss > 0 ? d2 / (2 * ss * ss) : 0.0;
-          for (const F& f : feats) {
-            const float* a = f.im->pixel(x, y);
-            const float* b = f.im->pixel(qx, qy);
-            if (!finite_n(a, f.ch)) continue;  // own value not finite: this feature is skipped
-            double dd = 0;
-            for (int c = 0; c < f.ch; ++c) dd += (double(a[c]) - b[c]) * (double(a[c]) - b[c]);
-            e += f.k * dd;
-          }
-          const double wq = std::exp(-e);
-          for (int c = 0; c < 3; ++c) s[c] += wq * cq[c];
-          sw += wq;
-        }
-      const float* cp = colour.pixel(x, y);
-      for (int c = 0; c < 3; ++c)
-        out.at(x, y, c) = float(sw > 0 ? s[c] / sw : (finite_n(cp, 3) ? cp[c] : 0.0));
-    }
-  return out;
 }
 
 void expect_close(const Image& got, const Image& want, double rel, const char* what = "") {
@@ -150,14 +91,14 @@ TEST(BilateralFilterTest, MatchesReferenceWithEveryFeature) {
   const Frame f = full_frame(33, 21, 2);
   const Params p = {{"spatial_sigma", 1.7}, {"colour_sigma", 0.4}, {"normal_sigma", 0.8}, {"position_sigma", 0.9},
                     {"albedo_sigma", 0.5}, {"use_depth", std::string("on")}, {"depth_sigma", 0.7}};
-  expect_close(run_on(f, p).out, reference(f, p), 1e-4);
+  expect_close(run_on(f, p).out, bilateral_reference(f, p), 1e-4);
   // One, two, three features, and a fixed radius larger than 3 sigma.
   expect_close(run_on(f, with(all_off(), {{"use_colour", std::string("on")}})).out,
-               reference(f, with(all_off(), {{"use_colour", std::string("on")}})), 1e-4, "colour");
+               bilateral_reference(f, with(all_off(), {{"use_colour", std::string("on")}})), 1e-4, "colour");
   const Params two = with(all_off(), {{"use_colour", std::string("on")}, {"use_normal", std::string("on")}});
-  expect_close(run_on(f, two).out, reference(f, two), 1e-4, "two");
+  expect_close(run_on(f, two).out, bilateral_reference(f, two), 1e-4, "two");
   const Params three = with(two, {{"use_position", std::string("on")}, {"radius", std::int64_t(7)}});
-  expect_close(run_on(f, three).out, reference(f, three), 1e-4, "three");
+  expect_close(run_on(f, three).out, bilateral_reference(f, three), 1e-4, "three");
 }
 
 TEST(BilateralFilterTest, TinyFeatureSigmaIsIdentity) {
@@ -182,7 +123,7 @@ TEST(BilateralFilterTest, SpatialSigmaLimits) {
   const Frame f = full_frame(15, 10, 5);
   EXPECT_EQ(run_on(f, {{"spatial_sigma", 0.0}}).out.storage(), f.image(Role::Colour).storage());
   const Params big = {{"spatial_sigma", 21.0}};  // radius 63 over a 15x10 image
-  expect_close(run_on(f, big).out, reference(f, big), 1e-4);
+  expect_close(run_on(f, big).out, bilateral_reference(f, big), 1e-4);
   BilateralFilter b;
   EXPECT_THROW(b.set("spatial_sigma", 22.0), Error);
   EXPECT_THROW(b.set("normal_sigma", 0.0), Error);  // off is use_normal=off, never sigma 0
@@ -244,7 +185,7 @@ TEST(BilateralFilterTest, AbsentFeaturesAreDroppedWithANoteOrRequired) {
   }
   EXPECT_TRUE(normal_note);
   EXPECT_TRUE(position_note);
-  expect_close(r.out, reference(f, {}), 1e-4);
+  expect_close(r.out, bilateral_reference(f, {}), 1e-4);
   try {
     run_on(f, {{"use_normal", std::string("on")}});
     FAIL() << "use_normal=on without a normal pass must throw";
@@ -273,7 +214,7 @@ TEST(BilateralFilterTest, DegenerateShapes) {
                       std::pair{17, 3}}) {
     SCOPED_TRACE(testing::Message() << w << "x" << h);
     const Frame f = full_frame(w, h, unsigned(w * 31 + h));
-    expect_close(run_on(f, mild()).out, reference(f, mild()), 1e-4);
+    expect_close(run_on(f, mild()).out, bilateral_reference(f, mild()), 1e-4);
   }
 }
 
@@ -288,7 +229,7 @@ TEST(BilateralFilterTest, TinyAndHugeValues) {
     Result r = run_on(f, p);
     EXPECT_EQ(r.repaired, 0u);
     for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
-    expect_close(r.out, reference(f, p), 1e-4);
+    expect_close(r.out, bilateral_reference(f, p), 1e-4);
   }
   Image big(12, 12, 3, FLT_MAX);
   big.at(2, 2, 2) = -FLT_MAX;
@@ -314,17 +255,17 @@ TEST(BilateralFilterTest, NonFiniteColourAndFeaturesFollowThePolicy) {
     Result r = run_on(f, p);
     EXPECT_EQ(r.repaired, 0u);
     for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
-    expect_close(r.out, reference(f, p), 1e-4);
+    expect_close(r.out, bilateral_reference(f, p), 1e-4);
     // A 3x3 window inside the blob has no usable sample: the pixel keeps its colour (if finite).
     const Params narrow = with(p, {{"spatial_sigma", 0.3}});
     const Result nr = run_on(f, narrow);
-    expect_close(nr.out, reference(f, narrow), 1e-4);
+    expect_close(nr.out, bilateral_reference(f, narrow), 1e-4);
     if (role != Role::Colour)
       for (int c = 0; c < 3; ++c) EXPECT_EQ(nr.out.at(14, 1, c), f.image(Role::Colour).at(14, 1, c));
     // With the feature off the non-finite values do not matter (colour aside).
     if (role != Role::Colour) {
       const Params off = with(p, {{std::string("use_") + role_name(role), std::string("off")}});
-      expect_close(run_on(f, off).out, reference(f, off), 1e-4);
+      expect_close(run_on(f, off).out, bilateral_reference(f, off), 1e-4);
     }
   }
 }
@@ -383,7 +324,7 @@ TEST(BilateralFilterTest, EveryInstructionSetMatchesTheReference) {
     const ScopedIsa use(level);
     SCOPED_TRACE(isa_name(level));
     EXPECT_EQ(isa(), level);
-    expect_close(run_on(f, p).out, reference(f, p), 1e-4);
+    expect_close(run_on(f, p).out, bilateral_reference(f, p), 1e-4);
     EXPECT_EQ(run_on(f, fov, 1).out.storage(), run_on(f, fov, 2).out.storage());
     ++ran;
   }

@@ -9,13 +9,14 @@
 #include <string>
 #include <vector>
 
+#include "expect_error.h"
+#include "metrics_oracle.h"
 #include "util/error.h"
 
 namespace mcr {
 namespace {
 
-constexpr double kC1 = 0.0001;  // (0.01 * 1)^2
-constexpr double kC2 = 0.0009;  // (0.03 * 1)^2
+using namespace testutil;
 
 Image constant_image(int w, int h, float r, float g, float b, int channels = 3) {
   Image im(w, h, channels, 0.0f);
@@ -35,62 +36,6 @@ Image random_image(int w, int h, unsigned seed, float lo = 0.0f, float hi = 1.0f
   Image im(w, h, channels);
   for (float& v : im.storage()) v = dist(rng);
   return im;
-}
-
-// ---- Brute-force SSIM: full 2D window, explicit mirror indexing, no separability. ----
-
-// Mirror without repeating the edge pixel, bouncing until the index lands inside [0, n).
-int mirror(int i, int n) {
-  if (n == 1) return 0;
-  while (i < 0 || i >= n) {
-    if (i < 0) i = -i;
-    if (i >= n) i = 2 * (n - 1) - i;
-  }
-  return i;
-}
-
-double clamped(float v) {
-  if (!std::isfinite(v)) return 0.0;
-  return std::min(1.0, std::max(0.0, double(v)));
-}
-
-double brute_force_ssim(const Image& a, const Image& b) {
-  double kernel[11][11];
-  double total = 0.0;
-  for (int j = 0; j < 11; ++j)
-    for (int i = 0; i < 11; ++i) {
-      const double dx = i - 5, dy = j - 5;
-      kernel[j][i] = std::exp(-(dx * dx + dy * dy) / (2.0 * 1.5 * 1.5));
-      total += kernel[j][i];
-    }
-  for (auto& row : kernel)
-    for (double& k : row) k /= total;
-
-  const int w = a.width(), h = a.height();
-  double channel_sum = 0.0;
-  for (int c = 0; c < 3; ++c) {
-    double map_sum = 0.0;
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        double mx = 0, my = 0, exx = 0, eyy = 0, exy = 0;
-        for (int j = 0; j < 11; ++j)
-          for (int i = 0; i < 11; ++i) {
-            const int sx = mirror(x + i - 5, w), sy = mirror(y + j - 5, h);
-            const double p = clamped(a.at(sx, sy, c)), q = clamped(b.at(sx, sy, c));
-            const double k = kernel[j][i];
-            mx += k * p;
-            my += k * q;
-            exx += k * p * p;
-            eyy += k * q * q;
-            exy += k * p * q;
-          }
-        const double vx = exx - mx * mx, vy = eyy - my * my, cxy = exy - mx * my;
-        map_sum += ((2 * mx * my + kC1) * (2 * cxy + kC2)) /
-                   ((mx * mx + my * my + kC1) * (vx + vy + kC2));
-      }
-    channel_sum += map_sum / (double(w) * h);
-  }
-  return channel_sum / 3.0;
 }
 
 // ---- Tests ----
@@ -298,18 +243,6 @@ TEST(MetricsTest, ExtraChannelsAreIgnored) {
   EXPECT_EQ(m3.psnr, m45.psnr);
   EXPECT_EQ(m3.ssim, m45.ssim);
   EXPECT_EQ(temporal_error(a3, b3), temporal_error(a4, b5));
-}
-
-template <class Fn>
-void expect_error(Errc code, const std::vector<std::string>& in_message, Fn&& fn) {
-  try {
-    fn();
-    ADD_FAILURE() << "no mcr::Error thrown";
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << e.what();
-    for (const std::string& s : in_message)
-      EXPECT_NE(std::string(e.what()).find(s), std::string::npos) << e.what();
-  }
 }
 
 TEST(MetricsTest, SizeMismatchThrowsNamingBothSizes) {
