@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "kernels/feature_needs.h"
 #include "util/error.h"
 #include "util/isa.h"
 
@@ -47,11 +48,46 @@ void PassNeeds::use(Role r) {
     optional.push_back(r);
 }
 
+void check_passes(const PassNeeds& need, const Frame& frame, const std::string& who) {
+  // Missing passes grouped by the setting that needs them, in order of first mention:
+  // "the normal, position passes (for guide=normal_position)".
+  std::vector<std::pair<std::string, std::vector<std::string>>> groups;
+  for (std::size_t i = 0; i < need.required.size(); ++i) {
+    if (frame.has(need.required[i])) continue;
+    auto g = std::find_if(groups.begin(), groups.end(), [&](const auto& e) { return e.first == need.why[i]; });
+    if (g == groups.end()) g = groups.insert(groups.end(), {need.why[i], {}});
+    g->second.push_back(role_name(need.required[i]));
+  }
+  if (groups.empty()) return;
+  std::string text;
+  for (const auto& [why, roles] : groups) {
+    std::string names;
+    for (const std::string& r : roles) names += (names.empty() ? "" : ", ") + r;
+    text += std::string(text.empty() ? "the " : "; the ") + names + (roles.size() > 1 ? " passes" : " pass") +
+            (why.empty() ? "" : " (for " + why + ")");
+  }
+  throw Error(Errc::MissingPass, who + " needs " + text + ", absent in '" + frame.path + "'");
+}
+
 PassNeeds Filter::own_needs() const {
   PassNeeds n;
   for (Role r : info_.required) n.require(r);
-  for (Role r : info_.optional) n.use(r);
+  // The feature block's use_<f>=on makes a pass required (no-op without the block).
+  std::vector<Role> req, opt;
+  std::vector<std::string> why;
+  feature_needs(params_, req, why, opt);
+  for (std::size_t i = 0; i < req.size(); ++i) n.require(req[i], why[i]);
+  for (Role r : info_.optional)
+    if (std::find(opt.begin(), opt.end(), r) != opt.end() || !params_.has(std::string("use_") + role_name(r)) ||
+        params_.get_enum(std::string("use_") + role_name(r)) != "off")
+      n.use(r);
   return n;
+}
+
+std::vector<std::string> Filter::own_unused() const {
+  std::vector<std::string> u = feature_unused(params_);
+  for (std::string& s : foveation_unused(params_)) u.push_back(std::move(s));
+  return u;
 }
 
 PassNeeds Filter::needs() const {
@@ -73,17 +109,7 @@ std::vector<Role> Filter::missing_passes(const Frame& frame) const {
 
 Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   if (!committed_) throw Error(Errc::Internal, "filter '" + info_.name + "': execute() before commit()");
-  const PassNeeds need = needs();
-  std::string names;
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < need.required.size(); ++i)
-    if (!frame.has(need.required[i])) {
-      names += std::string(count++ ? ", " : "") + role_name(need.required[i]) +
-               (need.why[i].empty() ? "" : " (for " + need.why[i] + ")");
-    }
-  if (count)
-    throw Error(Errc::MissingPass, "filter '" + info_.name + "' needs the " + names + " pass" + (count > 1 ? "es" : "") +
-                                       ", absent in '" + frame.path + "'");
+  check_passes(needs(), frame, "filter '" + info_.name + "'");
   frame.check_sizes();
   notes_.clear();
   const int nthreads = options.nthreads;

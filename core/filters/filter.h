@@ -40,6 +40,10 @@ struct PassNeeds {
   void use(Role r);
 };
 
+// Throws MissingPass "<who> needs the normal (for use_normal=on), depth passes, absent in
+// '<file>'" when the frame lacks required passes.
+void check_passes(const PassNeeds& need, const Frame& frame, const std::string& who);
+
 struct ExecOptions {
   Roi roi;           // empty = whole frame; pixels outside keep the input colour
   int nthreads = 0;  // 0 = all cores
@@ -80,10 +84,12 @@ class Filter {
 
  protected:
   virtual void check_params() {}
-  // The filter's own needs under params_ (default: info().required / optional).
+  // The filter's own needs under params_ (default: info().required, plus the feature
+  // block's use_<f>=on; info().optional less the use_<f>=off ones).
   virtual PassNeeds own_needs() const;
-  // Settings of its own table that have no effect under params_ (check_params() time).
-  virtual std::vector<std::string> own_unused() const { return {}; }
+  // Settings of its own table that have no effect under params_ (commit() time; default:
+  // the feature block's and foveation's). Overrides add to Filter::own_unused().
+  virtual std::vector<std::string> own_unused() const;
   // The pixels run() reads to write roi (the preparation steps work there): default the
   // whole frame.
   virtual Roi reads(const Roi& roi, int width, int height) const {

@@ -34,8 +34,15 @@ std::vector<SampleScene> load_sample_manifest(const std::string& dir) {
       sc.description = s.value("description", std::string());
       sc.width = s.value("width", 0);
       sc.height = s.value("height", 0);
-      for (const auto& [spp, path] : s.at("noisy").items())
-        sc.noisy[std::stoi(spp)] = (fs::path(dir) / path.get<std::string>()).string();
+      for (const auto& [spp, path] : s.at("noisy").items()) {
+        // The keys are sample counts: "16", never "many" or "16x".
+        char* end = nullptr;
+        const long n = std::strtol(spp.c_str(), &end, 10);
+        if (spp.empty() || *end != '\0' || n <= 0 || n > 1 << 24)
+          throw Error(Errc::InvalidArgument, "sample manifest '" + file.string() + "': scene '" + sc.name +
+                                                 "' has a noisy entry '" + spp + "' that is not a sample count");
+        sc.noisy[int(n)] = (fs::path(dir) / path.get<std::string>()).string();
+      }
       sc.reference = (fs::path(dir) / s.at("reference").get<std::string>()).string();
       sc.reference_spp = s.value("reference_spp", 0);
       if (s.contains("frames")) {

@@ -5,6 +5,7 @@
 #include <limits>
 #include <vector>
 
+#include "image/luminance.h"
 #include "metrics/metrics_internal.h"
 
 namespace mcr {
@@ -122,9 +123,10 @@ double ssim(const Image& reference, const Image& image, int nthreads) {
 double temporal_error(const Image& previous, const Image& current, int nthreads) {
   check_pair(previous, current, "temporal_error", "previous frame", "current frame");
   const int w = previous.width(), h = previous.height();
+  // Non-finite channels count as 0, as in every metric.
   auto luminance = [](const float* p) {
-    return 0.2126 * finite_or_zero(p[0]) + 0.7152 * finite_or_zero(p[1]) +
-           0.0722 * finite_or_zero(p[2]);
+    const float q[3] = {float(finite_or_zero(p[0])), float(finite_or_zero(p[1])), float(finite_or_zero(p[2]))};
+    return mcr::luminance(q);
   };
   std::vector<double> rows(h);
   parallel_blocks(h, kRowsPerBlock, nthreads, [&](int y0, int y1) {

@@ -39,16 +39,7 @@ Image Reconstruction::run(const Frame& frame, const ExecOptions& options) {
   notes_.clear();
   if (!accumulate_) return filter_->execute(frame, options);
   // Accumulation's passes first: nothing is accumulated for a frame the filter refuses.
-  const PassNeeds need = needs();
-  std::string names;
-  std::size_t count = 0;
-  for (std::size_t i = 0; i < need.required.size(); ++i)
-    if (!frame.has(need.required[i]))
-      names += std::string(count++ ? ", " : "") + role_name(need.required[i]) +
-               (need.why[i].empty() ? "" : " (for " + need.why[i] + ")");
-  if (count)
-    throw Error(Errc::MissingPass, "filter '" + filter_->info().name + "' with accumulation needs the " + names +
-                                       " pass" + (count > 1 ? "es" : "") + ", absent in '" + frame.path + "'");
+  check_passes(needs(), frame, "filter '" + filter_->info().name + "' with accumulation");
   Frame accumulated = frame;
   Pass colour = accumulated.get(Role::Colour);
   const Image& in = colour.image;

@@ -166,5 +166,14 @@ TEST(SampleManifest, ShippedManifestNamesFilesThatExist) {
   }
 }
 
+// A noisy key that is not a sample count is a typed error naming the file and the key,
+// not a std::invalid_argument from a string conversion.
+TEST(SampleManifest, NonNumericSppIsInvalidArgumentNamingTheFile) {
+  const ScratchDir dir("mcrecon_manifest");
+  const std::string file = dir.path("manifest.json");
+  write_text(file, R"({"scenes": [{"name": "x", "noisy": {"many": "x.exr"}, "reference": "r.exr"}]})");
+  expect_error(Errc::InvalidArgument, {file, "many"}, [&] { load_sample_manifest(dir.str()); });
+}
+
 }  // namespace
 }  // namespace mcr

@@ -29,6 +29,12 @@ const FilterInfo& BilateralFilter::static_info() {
 
 void BilateralFilter::check_params() { check_foveation_params(params_, info().name); }
 
+std::vector<std::string> BilateralFilter::own_unused() const {
+  std::vector<std::string> u = Filter::own_unused();
+  unused_when(params_.get_int("order") == 0, "ridge", "with order=0", u);
+  return u;
+}
+
 void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
   cross_bilateral_fit(frame, colour, params_, info().name, roi, out, nthreads, [this](std::string s) { note(std::move(s)); },
                       scratch_);

@@ -13,6 +13,7 @@ class BilateralFilter : public Filter {
 
  protected:
   void check_params() override;
+  std::vector<std::string> own_unused() const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:

@@ -219,22 +219,17 @@ std::vector<Role> GuidedFilter::guide_passes(const std::string& guide) {
   return roles;
 }
 
+PassNeeds GuidedFilter::own_needs() const {
+  PassNeeds n;
+  n.require(Role::Colour);
+  const std::string& guide = params_.get_enum("guide");
+  for (Role r : guide_passes(guide)) n.require(r, "guide=" + guide + "; guide=luminance needs no feature pass");
+  return n;
+}
+
 void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& roi, Image& out, int nthreads) {
   const std::string& guide = params_.get_enum("guide");
-  const GuideChoice& choice = find_choice(guide);
-  {
-    std::string missing;
-    int count = 0;
-    for (const GroupSpec& g : choice.groups)
-      if (reads_pass(g.source) && !frame.has(source_role(g.source))) {
-        missing += std::string(missing.empty() ? "" : ", ") + role_name(source_role(g.source));
-        ++count;
-      }
-    if (count)
-      throw Error(Errc::MissingPass, "filter 'guided': guide=" + guide + " needs the " + missing + " pass" +
-                                         (count > 1 ? "es" : "") + ", absent in '" + frame.path +
-                                         "' (guide=luminance needs no feature pass)");
-  }
+  const GuideChoice& choice = find_choice(guide);  // its passes: checked by needs() before any work
   const int W = frame.width, H = frame.height;
   const int r = int(params_.get_int("radius"));
   const Image* colour = &colour_in;

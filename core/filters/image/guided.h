@@ -74,6 +74,7 @@ class GuidedFilter : public Filter {
   static std::vector<Role> guide_passes(const std::string& guide);
 
  protected:
+  PassNeeds own_needs() const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:

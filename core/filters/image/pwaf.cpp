@@ -150,6 +150,13 @@ void PwafFilter::check_params() {
                                            ") must not exceed max_radius (" + std::to_string(params_.get_int("max_radius")) + ")");
 }
 
+std::vector<std::string> PwafFilter::own_unused() const {
+  std::vector<std::string> u = Filter::own_unused();
+  const bool adaptive = params_.get_bool("adaptive");
+  for (const char* name : {"min_radius", "variance_max"}) unused_when(!adaptive, name, "with adaptive=false", u);
+  return u;
+}
+
 void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
   stats_ = PwafStats{};
   const int w = frame.width, h = frame.height;

@@ -100,6 +100,23 @@ const FilterInfo& BmfrFilter::static_info() {
   return info;
 }
 
+PassNeeds BmfrFilter::own_needs() const {
+  PassNeeds n = Filter::own_needs();
+  const std::string& features = params_.get_enum("features");
+  if (features == "with_albedo") n.require(Role::Albedo, "features=with_albedo");
+  if (features == "with_depth") n.require(Role::Depth, "features=with_depth");
+  return n;
+}
+
+std::vector<std::string> BmfrFilter::own_unused() const {
+  std::vector<std::string> u = Filter::own_unused();
+  const bool taa = params_.get_bool("taa");
+  for (const char* name : {"taa_alpha", "taa_clip", "taa_gamma", "taa_history"}) unused_when(!taa, name, "with taa=false", u);
+  unused_when(taa && params_.get_enum("taa_clip") != "ycocg_variance", "taa_gamma", "with taa_clip=rgb_minmax", u);
+  unused_when(!params_.get_bool("albedo_demodulation"), "albedo_floor", "with albedo_demodulation=false", u);
+  return u;
+}
+
 void BmfrFilter::check_params() {
   const std::int64_t b = params_.get_int("block_size");
   if (b != 0 && b < 8) throw Error(Errc::InvalidArgument, "filter 'bmfr': block_size must be 0 (auto) or 8..128, got " + std::to_string(b));
@@ -161,11 +178,6 @@ __attribute__((target("avx2"))) int remodulate_row_avx2(const float* s, const fl
 
 void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
   const int w = frame.width, h = frame.height;
-  const std::string& features = params_.get_enum("features");
-  if (features == "with_albedo" && !frame.has(Role::Albedo))
-    throw Error(Errc::MissingPass, "filter 'bmfr': features=with_albedo needs the albedo pass, absent in '" + frame.path + "'");
-  if (features == "with_depth" && !frame.has(Role::Depth))
-    throw Error(Errc::MissingPass, "filter 'bmfr': features=with_depth needs the depth pass, absent in '" + frame.path + "'");
   stage_ms_.fill(0.0);
   stage_cpu_ms_.fill(0.0);
   auto t0 = std::chrono::steady_clock::now();

@@ -54,6 +54,8 @@ class BmfrFilter : public Filter {
 
  protected:
   void check_params() override;
+  PassNeeds own_needs() const override;
+  std::vector<std::string> own_unused() const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
   // run() reads the colour in phase I only and writes the whole roi at the end.
   bool run_in_place() const override { return true; }
