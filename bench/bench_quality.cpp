@@ -22,17 +22,6 @@
 
 namespace {
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-bool wanted(const std::vector<std::string>& list, const std::string& name) {
-  return list.empty() || std::find(list.begin(), list.end(), name) != list.end();
-}
 
 struct Best {
   std::string setting;
@@ -53,8 +42,8 @@ int main(int argc, char** argv) {
     };
     if (a == "--spp") spp = std::stoi(next());
     else if (a == "--threads") threads = std::stoi(next());
-    else if (a == "--scenes") scenes_wanted = split(next());
-    else if (a == "--filters") filters_wanted = split(next());
+    else if (a == "--scenes") scenes_wanted = mcr::bench::split_list(next());
+    else if (a == "--filters") filters_wanted = mcr::bench::split_list(next());
     else if (a == "--json") json_path = next();
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
   }
@@ -64,7 +53,7 @@ int main(int argc, char** argv) {
     std::map<std::string, std::vector<std::pair<std::string, Best>>> summary;
     std::map<std::string, std::pair<mcr::ImageMetrics, mcr::ImageMetrics>> noisy;
     for (const mcr::SampleScene& scene : mcr::load_sample_manifest(mcr::default_samples_dir())) {
-      if (scene.is_sequence() || !scene.noisy.count(spp) || !wanted(scenes_wanted, scene.name)) continue;
+      if (scene.is_sequence() || !scene.noisy.count(spp) || !mcr::bench::wanted(scenes_wanted, scene.name)) continue;
       const mcr::LoadedScene loaded = mcr::load_scene(scene, spp);
       const mcr::Evaluation base = mcr::evaluate(loaded, nullptr, threads);
       mcr::Evaluation more = base;
@@ -75,7 +64,7 @@ int main(int argc, char** argv) {
       std::printf("%-8s %-10s %-50s %10s %10.5f %8.3f %7.4f\n", scene.name.c_str(), "(noisy)", (std::to_string(spp * 4) + " spp").c_str(), "-",
                   more.metrics.relmse, more.metrics.psnr, more.metrics.ssim);
       for (const std::string& name : mcr::filter_names()) {
-        if (!wanted(filters_wanted, name)) continue;
+        if (!mcr::bench::wanted(filters_wanted, name)) continue;
         const mcr::FilterInfo& info = mcr::filter_info(name);
         if (info.temporal) continue;  // sequences have their own benchmark
         const mcr::bench::Sweep& sweep = mcr::bench::sweep_for(name);
@@ -91,14 +80,8 @@ int main(int argc, char** argv) {
           for (double v : values) {
             auto filter = mcr::make_filter(name);
             std::string setting = demod ? "demod " : "";
-            {
-              std::stringstream vs(variant);
-              for (std::string kv; vs >> kv;) {
-                const std::size_t eq = kv.find('=');
-                filter->set_text(kv.substr(0, eq), kv.substr(eq + 1));
-                setting += kv + " ";
-              }
-            }
+            const std::string given = mcr::bench::apply_variant(*filter, variant);
+            if (!given.empty()) setting += given + " ";
             if (!std::isnan(v)) {
               filter->set(sweep.param, v);
               setting += sweep.param + "=" + mcr::param_value_text(filter->params().values().at(sweep.param));

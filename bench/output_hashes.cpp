@@ -22,20 +22,6 @@
 
 namespace {
 
-std::vector<std::string> split(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  for (std::string item; std::getline(ss, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
-bool wanted(const std::vector<std::string>& list, const std::string& name) {
-  if (list.empty()) return true;
-  for (const auto& s : list)
-    if (s == name) return true;
-  return false;
-}
 
 struct Fnv {
   std::uint64_t h = 1469598103934665603ull;
@@ -74,18 +60,18 @@ int main(int argc, char** argv) {
     if (i + 1 >= argc) { std::fprintf(stderr, "%s needs a value\n", a.c_str()); return 2; }
     const std::string v = argv[++i];
     if (a == "--threads") threads = std::stoi(v);
-    else if (a == "--scenes") scenes_wanted = split(v);
-    else if (a == "--filters") filters_wanted = split(v);
+    else if (a == "--scenes") scenes_wanted = mcr::bench::split_list(v);
+    else if (a == "--filters") filters_wanted = mcr::bench::split_list(v);
     else { std::fprintf(stderr, "unknown option %s\n", a.c_str()); return 2; }
   }
   try {
     std::printf("isa %s\n", mcr::isa_name(mcr::isa()));
     for (const mcr::SampleScene& scene : mcr::load_sample_manifest(mcr::default_samples_dir())) {
-      if (!wanted(scenes_wanted, scene.name)) continue;
+      if (!mcr::bench::wanted(scenes_wanted, scene.name)) continue;
       const int spp = scene.is_sequence() ? scene.noisy.begin()->first : 16;
       const mcr::LoadedScene loaded = mcr::load_scene(scene, spp);
       for (const std::string& name : mcr::filter_names()) {
-        if (!wanted(filters_wanted, name)) continue;
+        if (!mcr::bench::wanted(filters_wanted, name)) continue;
         const mcr::FilterInfo& info = mcr::filter_info(name);
         // Temporal filters run on sequences; image filters on stills with their whole sweep,
         // on sequences with their defaults, alone and after accumulation.
@@ -101,12 +87,8 @@ int main(int argc, char** argv) {
             for (double v : values) {
               auto filter = mcr::make_filter(name);
               std::string setting = demod ? "demod" : "";
-              std::stringstream vs(variant);
-              for (std::string kv; vs >> kv;) {
-                const std::size_t eq = kv.find('=');
-                filter->set_text(kv.substr(0, eq), kv.substr(eq + 1));
-                setting += (setting.empty() ? "" : " ") + kv;
-              }
+              const std::string given = mcr::bench::apply_variant(*filter, variant);
+              if (!given.empty()) setting += (setting.empty() ? "" : " ") + given;
               if (!std::isnan(v)) {
                 filter->set(sweep.param, v);
                 setting += (setting.empty() ? "" : " ") + sweep.param + "=" +

@@ -1,6 +1,8 @@
 #include "sweeps.h"
 
+#include <algorithm>
 #include <map>
+#include <sstream>
 
 namespace mcr::bench {
 
@@ -44,6 +46,29 @@ const Sweep& sweep_for(const std::string& filter) {
   static const Sweep none;
   const auto it = table().find(filter);
   return it == table().end() ? none : it->second;
+}
+
+std::vector<std::string> split_list(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  for (std::string item; std::getline(ss, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+bool wanted(const std::vector<std::string>& list, const std::string& name) {
+  return list.empty() || std::find(list.begin(), list.end(), name) != list.end();
+}
+
+std::string apply_variant(Filter& filter, const std::string& variant) {
+  std::string text;
+  std::stringstream vs(variant);
+  for (std::string kv; vs >> kv;) {
+    const std::size_t eq = kv.find('=');
+    filter.set_text(kv.substr(0, eq), eq == std::string::npos ? "" : kv.substr(eq + 1));
+    text += (text.empty() ? "" : " ") + kv;
+  }
+  return text;
 }
 
 std::vector<std::string> sweep_variants(const std::string& filter) {

@@ -5,6 +5,8 @@
 #include <string>
 #include <vector>
 
+#include "filters/filter.h"
+
 namespace mcr::bench {
 
 struct Sweep {
@@ -19,5 +21,12 @@ const Sweep& sweep_for(const std::string& filter);
 // Every setting the quality benchmark runs for a filter, in its order: the common
 // variants ("", firefly_k=2, firefly_k=1), then the filter's own.
 std::vector<std::string> sweep_variants(const std::string& filter);
+
+// "a,b" -> {"a", "b"} (empty items dropped), for --scenes / --filters.
+std::vector<std::string> split_list(const std::string& s);
+// True when `list` is empty (everything wanted) or holds `name`.
+bool wanted(const std::vector<std::string>& list, const std::string& name);
+// Sets every key=value of `variant` ("k=v k=v") on the filter; returns them space-separated.
+std::string apply_variant(Filter& filter, const std::string& variant);
 
 }  // namespace mcr::bench

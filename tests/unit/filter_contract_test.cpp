@@ -120,5 +120,47 @@ TEST(FilterContract, GenericAndBestInstructionSetsAgree) {
   }
 }
 
+// A filter that takes no preparation step (a per-sample filter) gets none of their
+// parameters and reads the colour exactly as rendered, holes and fireflies included.
+class NoStepsFilter : public Filter {
+ public:
+  NoStepsFilter() : Filter(static_info()) {}
+  static const FilterInfo& static_info() {
+    static const FilterInfo info = [] {
+      FilterInfo i;
+      i.name = "no_steps";
+      i.steps = PrepSteps::none();
+      i.params = with_preparation_params({ParamSpec::Float("gain", 1.0, 0.0, 10.0, "output = gain * input")}, i.steps);
+      i.required = {Role::Colour};
+      return i;
+    }();
+    return info;
+  }
+  Image seen;
+
+ protected:
+  void run(const Frame&, const Image& colour, const Roi& roi, Image& out, int) override {
+    seen = colour;
+    const float g = float(params_.get_float("gain"));
+    for (int y = roi.y0; y < roi.y1; ++y)
+      for (int x = roi.x0; x < roi.x1; ++x)
+        for (int c = 0; c < 3; ++c) out.pixel(x, y)[c] = g * colour.pixel(x, y)[c];
+  }
+};
+
+TEST(FilterContract, AFilterWithoutStepsSeesTheRenderAsItIs) {
+  NoStepsFilter f;
+  for (const char* p : {"demodulate", "albedo_floor", "albedo_prefilter", "holes", "firefly_k", "firefly_radius", "clamp"})
+    EXPECT_FALSE(f.params().has(p)) << p;
+  EXPECT_EQ(f.params().values().size(), 1u);
+  f.set("gain", 2.0);
+  f.commit();
+  const Frame frame = busy_frame(20, 15, 14);  // holes and spikes the steps would change
+  const Image out = f.execute(frame);
+  const Image& in = frame.image(Role::Colour);
+  EXPECT_EQ(f.seen.storage(), in.storage());
+  for (std::size_t i = 0; i < out.storage().size(); ++i) ASSERT_EQ(out.storage()[i], 2.0f * in.storage()[i]);
+}
+
 }  // namespace
 }  // namespace mcr
