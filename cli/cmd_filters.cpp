@@ -20,12 +20,20 @@ Run add_filters(CLI::App& app) {
     for (const auto& name : filter_names()) {
       const FilterInfo& f = filter_info(name);
       std::cout << f.name << ": " << f.summary << (f.temporal ? " [temporal]" : "") << "\n";
-      std::cout << "  needs:";
-      for (Role r : f.required) std::cout << " " << role_name(r);
-      if (!f.optional.empty()) {
+      // Under the default settings (other settings may need more: `info` and errors say which).
+      auto filter = make_filter(name);
+      filter->commit();
+      const PassNeeds need = filter->needs();
+      std::cout << "  needs (defaults):";
+      for (Role r : need.required) std::cout << " " << role_name(r);
+      if (!need.optional.empty()) {
         std::cout << "; uses when present:";
-        for (Role r : f.optional) std::cout << " " << role_name(r);
+        for (Role r : need.optional) std::cout << " " << role_name(r);
       }
+      const PrepSteps& st = f.steps;
+      std::cout << "\n  preparation steps:" << (st.holes ? " holes" : "") << (st.albedo_prefilter ? " albedo_prefilter" : "")
+                << (st.demodulate ? " demodulate" : "") << (st.outliers ? " outliers" : "")
+                << (!st.holes && !st.albedo_prefilter && !st.demodulate && !st.outliers ? " none" : "");
       std::cout << "\n  non-finite input: " << f.nonfinite_policy << "\n";
       for (const ParamSpec& s : f.params) {
         std::cout << "  --set " << std::left << std::setw(16) << s.name << " " << param_type_name(s.type)
