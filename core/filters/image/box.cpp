@@ -23,6 +23,10 @@ const FilterInfo& BoxFilter::static_info() {
   return info;
 }
 
+Roi BoxFilter::reads(const Roi& roi, int width, int height) const {
+  return roi.grown(int(params_.get_int("radius")), width, height);
+}
+
 void BoxFilter::run(const Frame& frame, const Image& in, const Roi& roi, Image& out, int nthreads) {
   const int r = int(params_.get_int("radius"));
   const int w = frame.width, h = frame.height;

@@ -11,6 +11,7 @@ class BoxFilter : public Filter {
   static const FilterInfo& static_info();
 
  protected:
+  Roi reads(const Roi& roi, int width, int height) const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 };
 

@@ -44,6 +44,12 @@ const FilterInfo& GaussianFilter::static_info() {
   return info;
 }
 
+Roi GaussianFilter::reads(const Roi& roi, int width, int height) const {
+  int r = gaussian_radius(params_.get_float("sigma"));
+  if (params_.get_bool("foveated")) r = std::max(r, gaussian_radius(params_.get_float("sigma_outer")));
+  return roi.grown(r, width, height);
+}
+
 void GaussianFilter::check_params() { check_foveation_params(params_, info().name); }
 
 void GaussianFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {

@@ -16,6 +16,7 @@ class GaussianFilter : public Filter {
 
  protected:
   void check_params() override;
+  Roi reads(const Roi& roi, int width, int height) const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:
