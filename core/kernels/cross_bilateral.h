@@ -1,7 +1,7 @@
 #pragma once
 // Shared machinery of the edge-avoiding filters (bilateral, atrous) and of the
-// foveated Gaussian: the per-feature parameter block, planar (SoA) copies of the
-// colour and feature passes made once per execute, and one vectorised kernel that
+// foveated Gaussian: the per-feature parameter block, the feature guides (planar
+// copies, kernels/planes.h, made once per execute), and one vectorised kernel that
 // sums w(p,q) c(q) over a grid of taps around every pixel p:
 //
 //   w(p,q) = h(q-p) * valid(q) * exp(-( s(p) |q-p|^2 + sum_f k_f(p) |f(p) - f(q)|^2 ))
@@ -30,6 +30,7 @@
 #include <vector>
 
 #include "kernels/foveation.h"
+#include "kernels/planes.h"
 #include "util/params.h"
 #include "image/pass.h"
 
@@ -48,46 +49,6 @@ struct FeatureDefaults {
 ParamTable feature_params(const FeatureDefaults& defaults = {});
 // {"colour_sigma", "normal_sigma", ...}: the names to pass to with_foveation().
 std::vector<std::string> feature_sigma_names();
-
-
-// Layout of every plane of one execute(): the pixels of `box` (absolute image
-// coordinates), row-major, each row padded by kPlanePad zero columns on both
-// sides so that the kernel's vector loads never need a bounds check.
-inline constexpr int kPlanePad = 16;  // >= the widest vector (16 lanes)
-struct PlaneBox {
-  Roi box;
-  int stride = 0;
-  PlaneBox() = default;
-  explicit PlaneBox(const Roi& b) : box(b), stride((b.empty() ? 0 : b.width()) + 2 * kPlanePad) {}
-  std::size_t size() const { return box.empty() ? 0 : std::size_t(stride) * std::size_t(box.height()); }
-  std::size_t index(int x, int y) const {
-    return std::size_t(y - box.y0) * std::size_t(stride) + std::size_t(x - box.x0 + kPlanePad);
-  }
-  std::vector<float> plane(float fill = 0.0f) const;  // pads are 0 whatever the fill
-  // Makes v a plane of this layout reusing its memory (no page faults from one
-  // frame to the next): pads zeroed, interior left as it was unless `fill` is given.
-  void prepare(std::vector<float>& v) const;
-  void prepare(std::vector<float>& v, float fill) const;
-};
-
-// Planar copy of the RGB input over a box.
-struct ColourPlanes {
-  PlaneBox pb;
-  std::vector<float> c[3];  // non-finite pixels hold 0 (all three channels)
-  std::vector<float> ok;    // 1 where all three channels are finite, else 0
-  float scale = 1.0f;       // power of two the colour was multiplied by (exact; undone on
-                            // output). 1 while max |c| is in [2^-20, 2^100]; above, max |c|
-                            // is brought below 2^100 so no weighted sum of up to 129^2 taps
-                            // can overflow; below, it is raised (by at most 2^64) so tiny
-                            // images (1e-30) keep full precision clear of the denormals
-};
-// clamp > 0: finite channels are clamped to [-clamp, clamp] first (firefly clamp).
-// Fills `p`, reusing the memory it holds from an earlier call.
-void planar_colour(const Image& colour, const Roi& box, double clamp, int nthreads, ColourPlanes& p);
-
-// out(x, y, c) = planes[c] / scale over roi (rounded from double, clamped to +-FLT_MAX).
-void store_colour(const float* const planes[3], const PlaneBox& pb, float scale, const Roi& roi, Image& out,
-                  int nthreads);
 
 // The feature guides of one execute(): every enabled feature whose pass exists,
 // copied to planes once. k_f(p) = 1/(2 sigma_f(p)^2) with the foveated sigma of

@@ -5,6 +5,7 @@
 
 #include "kernels/feature_regression.h"
 #include "kernels/noise_relative_colour.h"
+#include "kernels/planes.h"
 #include "util/parallel.h"
 
 namespace mcr {

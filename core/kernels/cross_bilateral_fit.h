@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "kernels/cross_bilateral.h"
+#include "kernels/planes.h"
 #include "util/params.h"
 
 namespace mcr {

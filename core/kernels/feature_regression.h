@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "kernels/cross_bilateral.h"
+#include "kernels/planes.h"
 
 namespace mcr {
 

@@ -6,6 +6,7 @@
 
 #include "image/luminance.h"
 #include "kernels/noise_variance.h"
+#include "kernels/planes.h"
 #include "util/parallel.h"
 
 namespace mcr {

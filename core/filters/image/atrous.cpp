@@ -6,6 +6,7 @@
 #include "kernels/cross_bilateral.h"
 #include "kernels/foveation.h"
 #include "kernels/noise_relative_colour.h"
+#include "kernels/planes.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
