@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
 #include "kernels/noise_relative_colour.h"
 #include "kernels/planes.h"
