@@ -12,6 +12,9 @@
 // -86 (and for NaN or infinite ones, so an overflowing feature difference gives
 // weight 0, never NaN). 4, 8 or 16 pixels are processed at once (GCC vector
 // extensions), with AVX-512 or AVX2+FMA chosen at run time (util/isa.h), SSE2 otherwise.
+// cross_bilateral.cpp builds and dispatches the rows; the block of W pixels is in
+// cross_bilateral_block.h, the path that shares each symmetric pair's exponential in
+// cross_bilateral_symmetric.h.
 #include <cmath>
 #include <vector>
 
