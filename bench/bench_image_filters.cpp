@@ -13,7 +13,6 @@
 #include <vector>
 #include <random>
 
-#include "kernels/cross_bilateral.h"
 #include "filters/registry.h"
 #include "util/isa.h"
 

@@ -1,8 +1,7 @@
 #pragma once
-// Shared machinery of the edge-avoiding filters (bilateral, atrous) and of the
-// foveated Gaussian: the per-feature parameter block, planar (SoA) copies of the
-// colour and feature passes made once per execute, and one vectorised kernel that
-// sums w(p,q) c(q) over a grid of taps around every pixel p:
+// The vectorised kernel of the edge-avoiding filters (bilateral, atrous) and of the
+// foveated Gaussian: one pass sums w(p,q) c(q) over a grid of taps around every pixel p
+// of planes laid out by kernels/planes.h, with the guides of kernels/feature_guides.h:
 //
 //   w(p,q) = h(q-p) * valid(q) * exp(-( s(p) |q-p|^2 + sum_f k_f(p) |f(p) - f(q)|^2 ))
 //   k_f = 1 / (2 sigma_f^2),  s = 1 / (2 sigma_spatial^2)
@@ -13,107 +12,17 @@
 // -86 (and for NaN or infinite ones, so an overflowing feature difference gives
 // weight 0, never NaN). 4, 8 or 16 pixels are processed at once (GCC vector
 // extensions), with AVX-512 or AVX2+FMA chosen at run time (util/isa.h), SSE2 otherwise.
-//
-// Features and their on/off convention (the help text of every use_<f>):
-//   use_<f> = auto  used when the frame has the pass; when it has not, the weight is
-//                   dropped with a note() (colour always exists: auto = on)
-//           = on    required: a frame without the pass is an error (Errc::MissingPass)
-//           = off   not used
-//   <f>_sigma > 0   sigma of that weight, in the pass' units (colour: radiance as
-//                   filtered, i.e. after demodulation; normal: unit vectors; position,
-//                   depth: scene units; albedo: reflectance)
-// Normals are Blender's filtered camera-space Denoising Normal (Prefer::Feature),
-// positions world space, depth its first channel.
+// cross_bilateral.cpp builds and dispatches the rows; the block of W pixels is in
+// cross_bilateral_block.h, the path that shares each symmetric pair's exponential in
+// cross_bilateral_symmetric.h.
 #include <cmath>
-#include <functional>
-#include <string>
 #include <vector>
 
-#include "kernels/foveation.h"
-#include "util/params.h"
-#include "image/pass.h"
+#include "image/image.h"
+#include "kernels/feature_guides.h"
+#include "kernels/planes.h"
 
 namespace mcr {
-
-enum class Feature { Colour, Normal, Position, Albedo, Depth };
-inline constexpr int kFeatureCount = 5;
-const char* feature_name(Feature f);  // "colour", "normal", "position", "albedo", "depth"
-
-struct FeatureDefaults {
-  double sigma[kFeatureCount] = {2.0, 0.2, 0.2, 0.1, 0.1};
-  const char* use[kFeatureCount] = {"auto", "auto", "auto", "auto", "off"};
-};
-
-// The per-feature block: use_<f> and <f>_sigma for the five features, in order.
-ParamTable feature_params(const FeatureDefaults& defaults = {});
-// {"colour_sigma", "normal_sigma", ...}: the names to pass to with_foveation().
-std::vector<std::string> feature_sigma_names();
-
-
-// Layout of every plane of one execute(): the pixels of `box` (absolute image
-// coordinates), row-major, each row padded by kPlanePad zero columns on both
-// sides so that the kernel's vector loads never need a bounds check.
-inline constexpr int kPlanePad = 16;  // >= the widest vector (16 lanes)
-struct PlaneBox {
-  Roi box;
-  int stride = 0;
-  PlaneBox() = default;
-  explicit PlaneBox(const Roi& b) : box(b), stride((b.empty() ? 0 : b.width()) + 2 * kPlanePad) {}
-  std::size_t size() const { return box.empty() ? 0 : std::size_t(stride) * std::size_t(box.height()); }
-  std::size_t index(int x, int y) const {
-    return std::size_t(y - box.y0) * std::size_t(stride) + std::size_t(x - box.x0 + kPlanePad);
-  }
-  std::vector<float> plane(float fill = 0.0f) const;  // pads are 0 whatever the fill
-  // Makes v a plane of this layout reusing its memory (no page faults from one
-  // frame to the next): pads zeroed, interior left as it was unless `fill` is given.
-  void prepare(std::vector<float>& v) const;
-  void prepare(std::vector<float>& v, float fill) const;
-};
-
-// Planar copy of the RGB input over a box.
-struct ColourPlanes {
-  PlaneBox pb;
-  std::vector<float> c[3];  // non-finite pixels hold 0 (all three channels)
-  std::vector<float> ok;    // 1 where all three channels are finite, else 0
-  float scale = 1.0f;       // power of two the colour was multiplied by (exact; undone on
-                            // output). 1 while max |c| is in [2^-20, 2^100]; above, max |c|
-                            // is brought below 2^100 so no weighted sum of up to 129^2 taps
-                            // can overflow; below, it is raised (by at most 2^64) so tiny
-                            // images (1e-30) keep full precision clear of the denormals
-};
-// clamp > 0: finite channels are clamped to [-clamp, clamp] first (firefly clamp).
-// Fills `p`, reusing the memory it holds from an earlier call.
-void planar_colour(const Image& colour, const Roi& box, double clamp, int nthreads, ColourPlanes& p);
-
-// out(x, y, c) = planes[c] / scale over roi (rounded from double, clamped to +-FLT_MAX).
-void store_colour(const float* const planes[3], const PlaneBox& pb, float scale, const Roi& roi, Image& out,
-                  int nthreads);
-
-// The feature guides of one execute(): every enabled feature whose pass exists,
-// copied to planes once. k_f(p) = 1/(2 sigma_f(p)^2) with the foveated sigma of
-// each pixel, and 0 where p's own value of f is not finite (that pixel then
-// ignores feature f as a centre); stored as one constant unless it varies.
-struct Guides {
-  struct Guide {
-    Feature feature = Feature::Normal;
-    int channels = 3;
-    std::vector<float> c[3];  // non-finite values hold 0
-    float k_const = 0.0f;     // k everywhere when the plane k is empty
-    std::vector<float> k;
-  };
-  PlaneBox pb;
-  bool colour = false;            // colour weight on
-  float colour_a_const = 0.0f;    // sqrt(k) = 1/(sqrt(2) sigma) of the colour weight (unscaled colour) ...
-  std::vector<float> colour_a;    // ... per pixel when foveated
-  std::vector<Guide> list;        // enabled non-colour features present in the frame, Feature order
-  std::vector<float> ok;          // 1 where every guide in list is finite, else 0
-  std::vector<std::string> used;  // names of the features in use, colour first
-};
-// Reads use_<f>/<f>_sigma (and the _outer twins when foveated). Features set to
-// "auto" whose pass is absent are dropped through note(); "on" ones throw MissingPass.
-// Fills `g`, reusing the memory it holds from an earlier call.
-void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& fov, const std::string& filter,
-                   const PlaneBox& pb, const std::function<void(std::string)>& note, int nthreads, Guides& g);
 
 // Half width of a Gaussian window of standard deviation sigma: ceil(3 sigma), 0 for sigma 0.
 inline int gaussian_radius(double sigma) { return sigma > 0 ? int(std::ceil(3.0 * sigma - 1e-6)) : 0; }

@@ -3,8 +3,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
 #include "kernels/feature_regression.h"
+#include "kernels/foveation.h"
 #include "kernels/noise_relative_colour.h"
+#include "kernels/planes.h"
 #include "util/parallel.h"
 
 namespace mcr {

@@ -12,7 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "kernels/cross_bilateral.h"
+#include "image/image.h"
+#include "image/pass.h"
+#include "kernels/feature_guides.h"
+#include "kernels/planes.h"
 #include "util/params.h"
 
 namespace mcr {

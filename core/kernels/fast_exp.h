@@ -1,9 +1,9 @@
 #pragma once
 // The kernels' exponentials, both written here: exp_neg_v, the W-lane float exp(-e) of the
-// edge-avoiding kernels (GCC vector extensions; cross_bilateral.cpp and
-// feature_regression.cpp, only inside always-inlined code of functions compiled for one
-// instruction set), and exp_neg_d, the double one of pwaf's weights (the float one's 2e-7
-// would show in pwaf's sums of up to 65^2 weights).
+// edge-avoiding kernels (GCC vector extensions; cross_bilateral.cpp with its block and
+// symmetric headers, and feature_regression.cpp, only inside always-inlined code of
+// functions compiled for one instruction set), and exp_neg_d, the double one of pwaf's
+// weights (the float one's 2e-7 would show in pwaf's sums of up to 65^2 weights).
 #include <cstdint>
 #include <cstring>
 

@@ -10,6 +10,8 @@
 #include <cstring>
 
 #include "kernels/fast_exp.h"
+#include "kernels/feature_guides.h"
+#include "kernels/planes.h"
 #include "util/error.h"
 #include "util/isa.h"
 #include "util/parallel.h"

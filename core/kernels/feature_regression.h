@@ -13,7 +13,8 @@
 // scaled by their own weight's 1/(sqrt(2) sigma), so lambda is unit-free.
 #include <vector>
 
-#include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
+#include "kernels/planes.h"
 
 namespace mcr {
 

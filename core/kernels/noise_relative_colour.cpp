@@ -5,7 +5,10 @@
 #include <cstdint>
 
 #include "image/luminance.h"
+#include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
 #include "kernels/noise_variance.h"
+#include "kernels/planes.h"
 #include "util/parallel.h"
 
 namespace mcr {

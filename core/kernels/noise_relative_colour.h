@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
 #include "util/params.h"
 #include "image/image.h"
 #include "image/pass.h"

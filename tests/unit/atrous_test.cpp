@@ -11,7 +11,6 @@
 #include <random>
 #include <vector>
 
-#include "kernels/cross_bilateral.h"
 #include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"

@@ -10,7 +10,6 @@
 #include "bilateral_reference.h"
 #include "feature_filter_testutil.h"
 #include "filters/image/bilateral.h"
-#include "kernels/cross_bilateral.h"
 #include "util/isa.h"
 
 namespace mcr {

@@ -4,8 +4,10 @@
 #include <cmath>
 
 #include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
 #include "kernels/noise_relative_colour.h"
+#include "kernels/planes.h"
 #include "util/error.h"
 #include "util/parallel.h"
 

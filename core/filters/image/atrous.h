@@ -1,5 +1,6 @@
 #pragma once
-#include "kernels/cross_bilateral.h"
+#include "kernels/feature_guides.h"
+#include "kernels/planes.h"
 #include "filters/filter.h"
 
 namespace mcr {

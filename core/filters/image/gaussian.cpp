@@ -5,6 +5,7 @@
 
 #include "kernels/cross_bilateral.h"
 #include "kernels/foveation.h"
+#include "kernels/planes.h"
 #include "util/isa.h"
 #include "util/parallel.h"
 

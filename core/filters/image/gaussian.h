@@ -1,5 +1,5 @@
 #pragma once
-#include "kernels/cross_bilateral.h"
+#include "kernels/planes.h"
 #include "filters/filter.h"
 
 namespace mcr {

@@ -24,8 +24,9 @@ namespace mcr {
 // works on planar float features per block (double only in the QR and the synthesis
 // sums), one task per block. The filter runs in place (no output copy in the base class).
 // On x86-64 CPUs with AVX2 (checked at run time) the hot row loops of every stage run 8
-// pixels at a time (temporal/*_avx2, bmfr_taa, bmfr_fit); they do the float operations
-// of the scalar loops in the same order without FMA, so both builds give the same bits.
+// pixels at a time (temporal/*_avx2, bmfr_taa, bmfr_fit, bmfr_fit_features); they do the
+// float operations of the scalar loops in the same order without FMA, so both builds give
+// the same bits.
 // Temporal: history lives in the object; reset() drops it. A size change or a camera
 // cut (more than cut_fraction of the pixels lose every reprojection tap) restarts it.
 // The whole frame is always processed (history needs it); only the roi is written.

@@ -1,0 +1,41 @@
+#pragma once
+// The feature columns of BMFR's phase II fit (bmfr_fit.cpp), in bmfr_fit_features.cpp:
+// which raw channels each feature set fits, the scaling of a block's column to [-1, 1]
+// over its finite pixels, and the AVX2 gather of the default set's block rows.
+#include <cstddef>
+#include <string>
+
+namespace mcr::bmfr {
+
+// Raw (unscaled) feature channels per feature set. The fitted columns are then
+// [1, raw scaled to [-1,1] ..., squares of the scaled positions rescaled to [-1,1]].
+struct FeatureLayout {
+  bool squares = true;        // w^2 columns
+  bool albedo = false;        // + albedo RGB
+  bool depth = false;         // + depth
+  int raw() const { return 6 + (albedo ? 3 : 0) + (depth ? 1 : 0); }
+  int columns() const { return 1 + raw() + (squares ? 3 : 0); }
+};
+
+FeatureLayout layout_of(const std::string& set);  // the `features` parameter's value
+
+// Min and max of src over the pixels with mask 1 (+inf / -inf when none). Exact: the
+// order of a min/max does not matter.
+void masked_min_max(const float* src, const float* mask, int np, float& lo, float& hi);
+
+// dst = mask ? clamp((src - lo) * sc - 1, -1, 1) : 0 (src finite where mask is 1).
+void scale_masked(const float* src, const float* mask, int np, float lo, float sc, float* dst);
+
+#if defined(__GNUC__) && !defined(__clang__) && defined(__x86_64__)
+#define MCR_FIT_GATHER_AVX2 1
+
+// The default feature set's gather (normal and position, 3 channels each, no extras) of
+// block row y for pixels [0, n8), n8 a multiple of 8, p the first pixel's index in the
+// block: the loop in fit_block 8 pixels at a time (the same values; deinterleaved by
+// shuffles). Returns the new count of fitted rows.
+__attribute__((target("avx2"))) int gather_row_avx2(const float* nrow, const float* prow, const float* irow,
+                                                     const float* vrow, int n8, int p, std::size_t snp, float* raw,
+                                                     float* fin, float* zp, int* rows, int W);
+#endif
+
+}  // namespace mcr::bmfr
