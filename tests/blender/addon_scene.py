@@ -85,6 +85,13 @@ def case_render(filter_name):
     result["ref"] = written(scene)
 
 
+def roles(filter_name, params=None, accumulate=False):
+    """The roles needs() names for these settings, required and optional."""
+    import mcrecon_addon.native as native
+    n = native.get().needs(filter_name, params or {}, accumulate=accumulate)
+    return n["required"] + n["optional"]
+
+
 def case_passes():
     scene = room_scene()
     import mcrecon_addon.native as native
@@ -100,33 +107,24 @@ def case_passes():
             (abs(getattr(group, s["name"]) - s["default"]) <= 1e-6 * max(1, abs(s["default"])))
             if s["type"] == "float" else getattr(group, s["name"]) == s["default"]
             for s in info["parameters"])
-        needs = native.get().needs(info["name"])
-        seen[info["name"]] = {"toggles": toggles(scene), "defaults_ok": defaults_ok,
-                              "roles": needs["required"] + needs["optional"]}
+        seen[info["name"]] = {"toggles": toggles(scene), "defaults_ok": defaults_ok, "roles": roles(info["name"])}
     result["filters"] = seen
     # Settings other than the defaults: the toggles follow needs() of the chosen settings as
     # they change (a parameter of the chosen filter, accumulate), through the panel's properties.
     settings = {}
 
-    def record(label, filter_name, params=None, accumulate=False):
-        needs = native.get().needs(filter_name, params or {}, accumulate=accumulate)
-        settings[label] = {"toggles": toggles(scene), "roles": needs["required"] + needs["optional"]}
+    def switched_on(owner, prop, label, filter_name, params=None, accumulate=False):
+        """Records the toggles with owner.prop = True (needs() of the settings given), then undoes it."""
+        setattr(owner, prop, True)
+        settings[label] = {"toggles": toggles(scene), "roles": roles(filter_name, params, accumulate)}
+        setattr(owner, prop, False)
+    for name in ("box", "bilateral"):
+        mc.filter = name
+        settings[name] = {"toggles": toggles(scene), "roles": roles(name)}
+        switched_on(getattr(mc, "params_" + name), "demodulate", name + " demodulate", name, {"demodulate": True})
+    switched_on(mc, "accumulate", "bilateral accumulate", "bilateral", accumulate=True)
     mc.filter = "box"
-    record("box", "box")
-    mc.params_box.demodulate = True
-    record("box demodulate", "box", {"demodulate": True})
-    mc.params_box.demodulate = False
-    mc.accumulate = True
-    record("box accumulate", "box", accumulate=True)
-    mc.accumulate = False
-    mc.filter = "bilateral"
-    record("bilateral", "bilateral")
-    mc.params_bilateral.demodulate = True
-    record("bilateral demodulate", "bilateral", {"demodulate": True})
-    mc.params_bilateral.demodulate = False
-    mc.params_box.demodulate = True  # not the chosen filter: nothing changes
-    record("bilateral, box demodulate", "bilateral")
-    mc.params_box.demodulate = False
+    switched_on(mc, "accumulate", "box accumulate", "box", accumulate=True)
     result["settings"] = settings
     # The panel draws every parameter of the chosen filter (recorded by a stand-in layout).
     drawn = []
