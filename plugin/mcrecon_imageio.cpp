@@ -4,6 +4,9 @@
 //         reads as the filtered R,G,B,A float image that `mcrecon denoise` writes.
 // Output: "-o:fileformatname=mcrecon out.exr" with "mcrecon:KEY" attributes on the
 //         image filters every channel it is given and writes a real EXR there.
+// Both run a Reconstruction (accumulate=1: the accumulation stage before the filter)
+// with per-stream history (history.h), and describe the run in the header:
+// mcreconFilter, mcreconParameters, mcreconNotes (unused settings, the run's notes).
 //
 // OIIO 2.4 hazards this file is built around (see the shared notes):
 // - OIIO 2.4 offers a file that failed its own reader to every reader, ours
