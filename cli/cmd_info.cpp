@@ -4,6 +4,7 @@
 #include "filters/registry.h"
 #include "io/frame_reader.h"
 #include "json_views.h"
+#include "pipeline/reconstruction.h"
 
 namespace mcr::cli {
 
@@ -34,12 +35,17 @@ int run_info(const InfoArgs& a) {
   }
   for (const Pass& p : frame.passes) passes.push_back(to_json(p));
   for (const Pass& p : frame.extra) other.push_back({{"name", p.name}, {"channels", p.channels}});
+  // Which filters can run with their default settings (Filter::needs()): the required
+  // passes the file lacks, and the optional ones it has that they would use.
   nlohmann::json filters = nlohmann::json::array();
   for (const auto& name : filter_names()) {
-    auto f = make_filter(name);
-    nlohmann::json missing = nlohmann::json::array();
-    for (Role r : f->missing_passes(frame)) missing.push_back(role_name(r));
-    filters.push_back({{"name", name}, {"can_run", missing.empty()}, {"missing", missing}});
+    const PassNeeds need = make_committed_filter(name, {})->needs();
+    nlohmann::json missing = nlohmann::json::array(), uses = nlohmann::json::array();
+    for (Role r : need.required)
+      if (!frame.has(r)) missing.push_back(role_name(r));
+    for (Role r : need.optional)
+      if (frame.has(r)) uses.push_back(role_name(r));
+    filters.push_back({{"name", name}, {"can_run", missing.empty()}, {"missing", missing}, {"uses", uses}});
   }
   nlohmann::json j = {{"file", frame.path},   {"width", frame.width},     {"height", frame.height},
                       {"deep", bool(frame.deep)}, {"layers", frame.layers}, {"layer", frame.layer},
@@ -72,6 +78,10 @@ int run_info(const InfoArgs& a) {
   for (const auto& f : filters) {
     std::cout << "  " << f["name"].get<std::string>() << ": " << (f["can_run"].get<bool>() ? "can run" : "cannot run, lacks");
     for (const auto& m : f["missing"]) std::cout << " " << m.get<std::string>();
+    if (f["can_run"].get<bool>() && !f["uses"].empty()) {
+      std::cout << ", uses";
+      for (const auto& u : f["uses"]) std::cout << " " << u.get<std::string>();
+    }
     std::cout << "\n";
   }
   return 0;

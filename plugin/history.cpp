@@ -36,11 +36,11 @@ StreamHistory::Lease StreamHistory::acquire(const std::string& settings_key, con
   current_ = &s;
   current_number_ = fn.number;
   Lease lease;
-  lease.filter = s.filter.get();
-  lease.continued = s.filter->info().temporal && fn.number && s.last && *s.last + 1 == *fn.number;
+  lease.reconstruction = s.reconstruction.get();
+  lease.continued = s.reconstruction->temporal() && fn.number && s.last && *s.last + 1 == *fn.number;
   if (!lease.continued) {
     s.last.reset();
-    s.filter->reset();
+    s.reconstruction->reset();
   }
   return lease;
 }

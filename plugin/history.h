@@ -1,15 +1,16 @@
 #pragma once
-// Temporal history for the plugin: which filter object runs a frame, and whether
-// it keeps the history of the frame before.
+// Temporal history for the plugin: which reconstruction (accumulation stage +
+// filter) runs a frame, and whether it keeps the history of the frame before.
 //
-// The rule: a temporal filter (FilterInfo::temporal) continues its history on a
-// frame only when the previous frame this process filtered in the same stream
-// was the frame number just before it. A stream is one settings key (filter,
-// canonical parameter values, layer, pass overrides) plus one name pattern (the
-// file name with its last run of digits replaced by '#'). In every other case
-// (first frame of a stream, a gap, a frame read again or backwards, a name with
-// no frame number, or a failed frame before) the filter is reset() first.
-// Non-temporal filters never carry anything between frames.
+// The rule: a temporal reconstruction (Reconstruction::temporal(): a temporal
+// filter, or accumulation) continues its history on a frame only when the previous
+// frame this process filtered in the same stream was the frame number just before
+// it. A stream is one settings key (filter, canonical parameter values,
+// accumulate, layer, pass overrides) plus one name pattern (the file name with its
+// last run of digits replaced by '#'). In every other case (first frame of a
+// stream, a gap, a frame read again or backwards, a name with no frame number, or
+// a failed frame before) the reconstruction is reset() first. Non-temporal ones
+// never carry anything between frames.
 //
 // No OpenImageIO here: the logic is unit-tested with a fake filter.
 #include <functional>
@@ -18,7 +19,7 @@
 #include <optional>
 #include <string>
 
-#include "filters/filter.h"
+#include "pipeline/reconstruction.h"
 
 namespace mcr::plugin {
 
@@ -32,17 +33,17 @@ FrameName split_frame_number(const std::string& path);
 
 class StreamHistory {
  public:
-  using Factory = std::function<std::unique_ptr<Filter>()>;
+  using Factory = std::function<std::unique_ptr<Reconstruction>()>;
   explicit StreamHistory(std::size_t max_streams = 8) : max_streams_(max_streams) {}
 
   struct Lease {
-    Filter* filter = nullptr;  // valid until the next acquire()
+    Reconstruction* reconstruction = nullptr;  // valid until the next acquire()
     bool continued = false;    // true: history of frame N-1 is kept
   };
 
-  // The filter for `path` in the stream `settings_key`; `make` builds a committed
-  // filter when the stream is new. Calls reset() on a temporal filter unless it
-  // continues. Call done() or failed() after running it.
+  // The reconstruction for `path` in the stream `settings_key`; `make` builds one
+  // (committed filter) when the stream is new. Calls reset() unless it continues.
+  // Call done() or failed() after running it.
   Lease acquire(const std::string& settings_key, const std::string& path, const Factory& make);
   // The frame ran: the next frame number continues it.
   void done();
@@ -54,7 +55,7 @@ class StreamHistory {
  private:
   struct Stream {
     std::string key;
-    std::unique_ptr<Filter> filter;
+    std::unique_ptr<Reconstruction> reconstruction;
     std::optional<long long> last;  // frame number of the last frame that ran
   };
   std::list<Stream> streams_;  // most recently used first

@@ -4,6 +4,9 @@
 //         reads as the filtered R,G,B,A float image that `mcrecon denoise` writes.
 // Output: "-o:fileformatname=mcrecon out.exr" with "mcrecon:KEY" attributes on the
 //         image filters every channel it is given and writes a real EXR there.
+// Both run a Reconstruction (accumulate=1: the accumulation stage before the filter)
+// with per-stream history (history.h), and describe the run in the header:
+// mcreconFilter, mcreconParameters, mcreconNotes (unused settings, the run's notes).
 //
 // OIIO 2.4 hazards this file is built around (see the shared notes):
 // - OIIO 2.4 offers a file that failed its own reader to every reader, ours
@@ -81,6 +84,7 @@ std::string file_stamp(const std::string& path) {
 struct Result {
   int width = 0, height = 0;
   std::vector<float> rgba;
+  std::string notes;  // the reconstruction's notes after the run (mcreconNotes)
 };
 
 std::mutex g_cache_mutex;  // guards g_results; never held across an OIIO call
@@ -106,19 +110,34 @@ void cache_result(const std::string& key, std::shared_ptr<const Result> r) {
   while (g_results.size() > kMaxResults) g_results.pop_back();
 }
 
-// Runs the request's filter on one frame with the stream's history (see history.h).
-mcr::Image run_filter(const mp::Request& r, const std::string& settings, const std::string& frame_name,
-                      const mcr::Frame& frame) {
-  auto lease = g_history.acquire(settings, frame_name,
-                                 [&] { return mcr::make_committed_filter(r.filter, r.params); });
+struct Filtered {
+  mcr::Image rgb;
+  std::string notes;  // mp::notes_text of the reconstruction's notes after the run
+};
+
+// Runs the request's reconstruction (accumulation, filter) on one frame with the
+// stream's history (see history.h).
+Filtered run_filter(const mp::Request& r, const std::string& settings, const std::string& frame_name,
+                    const mcr::Frame& frame) {
+  auto lease = g_history.acquire(settings, frame_name, [&] { return mp::make_reconstruction(r); });
   try {
-    mcr::Image rgb = lease.filter->execute(frame, {});
+    Filtered f;
+    f.rgb = lease.reconstruction->run(frame, {});
+    f.notes = mp::notes_text(lease.reconstruction->notes());
     g_history.done();
-    return rgb;
+    return f;
   } catch (...) {
     g_history.failed();
     throw;
   }
+}
+
+// What the output's header says of the run: filter, every setting, notes (when any).
+std::vector<std::pair<std::string, std::string>> description(const std::string& filter, const std::string& params,
+                                                             const std::string& notes) {
+  std::vector<std::pair<std::string, std::string>> d = {{"mcreconFilter", filter}, {"mcreconParameters", params}};
+  if (!notes.empty()) d.emplace_back("mcreconNotes", notes);
+  return d;
 }
 
 // ---------------------------------------------------------------------------
@@ -143,17 +162,19 @@ class McreconInput final : public ImageInput {
     close();
     int width = 1, height = 1;
     mcr::PixelWindow window;
-    std::string params_text;
+    std::string params_text, notes;
     try {
       auto [source, query] = mp::split_name(name);
       mp::KeyValues settings = plugin_attributes(config);
       settings.insert(settings.end(), query.begin(), query.end());
       request_ = mp::make_request(source, settings, false);
       // Unknown filter and parameter errors first, as in the CLI.
-      const auto filter = mcr::make_committed_filter(request_.filter, request_.params);
-      params_text = mcr::parameters_text(*filter);
+      const auto reconstruction = mp::make_reconstruction(request_);
+      params_text = reconstruction->parameters_text();
+      notes = mp::notes_text(reconstruction->notes());  // the unused settings, before any run
       settings_ = mp::settings_key(request_, params_text);
       key_ = settings_ + '\n' + source + '\n' + file_stamp(source);
+      if (const auto done = cached_result(key_)) notes = done->notes;  // plain data: no OIIO call
       const ImageSpec src = source_header(source);
       width = src.width;
       height = src.height;
@@ -168,8 +189,7 @@ class McreconInput final : public ImageInput {
     m_spec.alpha_channel = 3;
     m_spec.attribute("Software", "mcrecon");
     if (deferred_error_.empty()) {
-      m_spec.attribute("mcreconFilter", request_.filter);
-      m_spec.attribute("mcreconParameters", params_text);
+      for (const auto& [name, value] : description(request_.filter, params_text, notes)) m_spec.attribute(name, value);
       m_spec.attribute("mcreconSource", request_.source);
     } else {
       m_spec.attribute("mcreconError", deferred_error_);
@@ -201,6 +221,7 @@ class McreconInput final : public ImageInput {
       return false;
     }
     if (!ensure_result()) return false;
+    if (!result_->notes.empty()) m_spec.attribute("mcreconNotes", result_->notes);  // the run's notes too
     const std::size_t row = std::size_t(m_spec.width) * 4;
     std::memcpy(data, result_->rgba.data() + std::size_t(ybegin - m_spec.y) * row,
                 std::size_t(yend - ybegin) * row * sizeof(float));
@@ -230,8 +251,10 @@ class McreconInput final : public ImageInput {
       const mcr::Frame frame = mcr::read_frame(request_.source, request_.read);
       if (frame.width != m_spec.width || frame.height != m_spec.height)
         throw mcr::Error(Errc::ReadFailed, "'" + request_.source + "' changed while it was read");
-      const mcr::Image rgb = run_filter(request_, settings_, request_.source, frame);
+      const Filtered filtered = run_filter(request_, settings_, request_.source, frame);
+      const mcr::Image& rgb = filtered.rgb;
       auto r = std::make_shared<Result>();
+      r->notes = filtered.notes;
       r->width = frame.width;
       r->height = frame.height;
       r->rgba.resize(std::size_t(frame.width) * frame.height * 4);
@@ -297,8 +320,7 @@ class McreconOutput final : public ImageOutput {
     }
     try {
       request_ = mp::make_request(name, plugin_attributes(spec), true);
-      const auto filter = mcr::make_committed_filter(request_.filter, request_.params);
-      params_text_ = mcr::parameters_text(*filter);
+      params_text_ = mp::make_reconstruction(request_)->parameters_text();
       settings_ = mp::settings_key(request_, params_text_);
       if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || spec.depth > 1)
         throw mcr::Error(Errc::InvalidArgument, "mcrecon output '" + name + "': needs a flat 2D image");
@@ -361,13 +383,12 @@ class McreconOutput final : public ImageOutput {
       mcr::Frame frame = mcr::frame_from_channels(shown_name_, m_spec.width, m_spec.height, names,
                                                   std::move(pixels_), request_.read);
       frame.window = mcr::window_of(m_spec);
-      const mcr::Image rgb = run_filter(request_, settings_, shown_name_, frame);
+      const Filtered filtered = run_filter(request_, settings_, shown_name_, frame);
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;
       wo.compression = request_.compression;
-      wo.attributes.emplace_back("mcreconFilter", request_.filter);
-      wo.attributes.emplace_back("mcreconParameters", params_text_);
-      mcr::write_result(name_, rgb, frame, wo);
+      wo.attributes = description(request_.filter, params_text_, filtered.notes);
+      mcr::write_result(name_, filtered.rgb, frame, wo);
       ok_ = true;
     } catch (const std::exception& e) {
       report(*this, e);

@@ -16,6 +16,15 @@ std::string lower(std::string s) {
   for (char& c : s) c = char(std::tolower(static_cast<unsigned char>(c)));
   return s;
 }
+
+// A yes/no setting: 0, 1, true or false, as typed (the error names the image, the setting
+// and the text).
+bool parse_switch(const std::string& key, const std::string& value, const std::string& image) {
+  if (value == "1" || value == "true") return true;
+  if (value == "0" || value == "false") return false;
+  throw Error(Errc::InvalidArgument, "'" + strip_oiiotool_temp(image) + "': " + key +
+                                         " expects 0, 1, true or false, got '" + value + "'");
+}
 }  // namespace
 
 bool is_plugin_name(const std::string& name) {
@@ -57,10 +66,10 @@ Request make_request(const std::string& source, const KeyValues& settings, bool 
       r.read.layer = value;
     } else if (role_from_name(key)) {
       r.read.overrides.push_back(parse_pass_override(key + "=" + value));  // the CLI's --pass checks
+    } else if (key == "accumulate") {
+      r.accumulate = parse_switch(key, value, source);
     } else if (output_side && key == "keep_passes") {
-      if (value != "0" && value != "1" && value != "true" && value != "false")
-        throw Error(Errc::InvalidArgument, "mcrecon:keep_passes expects 0 or 1, got '" + value + "'");
-      r.keep_passes = value == "1" || value == "true";
+      r.keep_passes = parse_switch(key, value, source);
     } else if (output_side && key == "compression") {
       r.compression = value;
     } else {
@@ -75,10 +84,21 @@ Request make_request(const std::string& source, const KeyValues& settings, bool 
   return r;
 }
 
+std::unique_ptr<Reconstruction> make_reconstruction(const Request& r) {
+  return std::make_unique<Reconstruction>(make_committed_filter(r.filter, r.params), r.accumulate);
+}
+
+std::string notes_text(const std::vector<std::string>& notes) {
+  std::string text;
+  for (const std::string& n : notes) text += (text.empty() ? "" : "; ") + n;
+  return text;
+}
+
 std::string settings_key(const Request& r, const std::string& canonical_params) {
   std::string key = "filter=" + r.filter + " layer=" + r.read.layer;
   for (const PassOverride& o : r.read.overrides) key += std::string(" ") + role_name(o.role) + "=" + o.value;
-  key += " keep_passes=" + std::to_string(int(r.keep_passes)) + " " + canonical_params;
+  key += " keep_passes=" + std::to_string(int(r.keep_passes)) + " accumulate=" + std::to_string(int(r.accumulate)) +
+         " " + canonical_params;
   return key;
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "io/frame_reader.h"
+#include "pipeline/reconstruction.h"
 
 namespace mcr::plugin {
 
@@ -24,6 +25,7 @@ struct Request {
   std::string filter;   // registry name
   KeyValues params;     // filter parameters, in the order given (last one wins)
   ReadOptions read;     // layer= and ROLE= pass overrides
+  bool accumulate = false;       // accumulation stage before the filter (the CLI's --accumulate)
   bool keep_passes = false;      // output side only (mcrecon:keep_passes)
   std::string compression = "zip";  // output side only (mcrecon:compression)
 };
@@ -36,12 +38,21 @@ std::pair<std::string, KeyValues> split_name(const std::string& name);
 // Builds a request from key=value settings, in order: first `config` (the
 // "mcrecon:" attributes of --iconfig or of the output spec, prefix removed), then
 // the name's query. Keys: filter, layer, a pass role (colour, albedo, normal, ...,
-// as the CLI's --pass ROLE=VALUE), keep_passes and compression (output only),
-// anything else is a parameter of the filter's table (checked by the filter).
-// Throws InvalidArgument (no filter, bad role value, bad keep_passes).
+// as the CLI's --pass ROLE=VALUE), accumulate (0, 1, true, false), keep_passes and
+// compression (output only), anything else is a parameter of the filter's table
+// (checked by the filter). Throws InvalidArgument (no filter, bad role value, bad
+// accumulate or keep_passes).
 Request make_request(const std::string& source, const KeyValues& settings, bool output_side);
 
-// "filter=box layer= normal=... radius=3": a stable text of what determines the
+// The request's filter (every parameter set and committed) behind its accumulation
+// stage: parameter errors surface here.
+std::unique_ptr<Reconstruction> make_reconstruction(const Request& r);
+
+// The reconstruction's notes (unused settings first) as one line, "; " between them:
+// the mcreconNotes attribute.
+std::string notes_text(const std::vector<std::string>& notes);
+
+// "filter=box layer= normal=... accumulate=0 radius=3": a stable text of what determines the
 // result (after the filter canonicalised its parameters), to key caches and history.
 std::string settings_key(const Request& r, const std::string& canonical_params);
 

@@ -4,7 +4,7 @@ import os
 
 import bpy
 
-from . import native, pass_output, passes, properties, render_hooks
+from . import native, pass_output, properties, render_hooks
 
 
 _ITEMS = []  # Blender needs the strings of dynamic enum items kept alive
@@ -30,9 +30,12 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
     frame_end: bpy.props.IntProperty(name="End", default=1)
     filter: bpy.props.EnumProperty(name="Filter", items=_filter_items,
                                    description="Filter (parameters from the scene's mcrecon settings)")
+    accumulate: bpy.props.BoolProperty(name="Accumulate", default=False,
+                                       description="Temporal accumulation before the filter (--accumulate)")
 
     def invoke(self, context, event):
         self.filter = context.scene.mcrecon.filter
+        self.accumulate = context.scene.mcrecon.accumulate
         self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}
@@ -51,7 +54,8 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
             return {"CANCELLED"}
         wm = context.window_manager
         try:
-            session = mc.Session(self.filter, properties.filter_params(context.scene.mcrecon, self.filter))
+            session = mc.Session(self.filter, properties.filter_params(context.scene.mcrecon, self.filter),
+                                 accumulate=self.accumulate)
             jobs = [(render_hooks.frame_path(src, f) if seq else src, render_hooks.frame_path(out, f) if seq else out)
                     for f in frames]
             missing = [i for i, _ in jobs if not os.path.exists(i)]
@@ -75,14 +79,19 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
 
 
 class MCRECON_OT_apply_passes(bpy.types.Operator):
-    """Enable exactly the passes the chosen mcrecon filter needs and turn Cycles' denoiser off"""
+    """Enable exactly the passes the chosen mcrecon filter's settings need or use and turn Cycles' denoiser off"""
     bl_idname = "mcrecon.apply_passes"
     bl_label = "Set Passes for Filter"
     bl_options = {"REGISTER", "UNDO"}
 
     def execute(self, context):
-        info = native.get().filter_info(context.scene.mcrecon.filter)
-        for m in passes.apply(context.scene, info):
+        mc = native.get()
+        try:
+            messages = properties.apply_passes(context.scene)
+        except mc.Error as e:
+            self.report({"ERROR"}, f"mcrecon: passes not changed: {e} [{e.kind}]")
+            return {"CANCELLED"}
+        for m in messages:
             self.report({"INFO"}, m)
         if pass_output.ensure(context.scene, log=lambda m: self.report({"INFO"}, m)) is not None:
             self.report({"INFO"}, "mcrecon: the output format is not MultiLayer: the 'mcrecon passes' "

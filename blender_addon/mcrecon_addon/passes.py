@@ -1,4 +1,6 @@
-"""Which Blender pass toggles a filter's pass roles need, and switching them."""
+"""Which Blender pass toggles the pass roles of a filter's settings need, and switching them.
+The roles come from the native module's needs() (they depend on the parameters: demodulate=true
+needs albedo, accumulate needs position and normal), never from a static list."""
 
 # Role (from the filter tables) -> (owner, attribute) on the view layer; owner "cycles" is
 # view_layer.cycles. Denoising Data gives Denoising Albedo / Normal / Depth at once.
@@ -17,30 +19,31 @@ def _owner(view_layer, owner):
     return getattr(view_layer, owner) if owner else view_layer
 
 
-def wanted_toggles(info):
-    """(toggles to turn on, roles Blender cannot provide) for a filter description."""
-    roles = list(info["required_passes"]) + list(info["optional_passes"])
+def wanted_toggles(needs):
+    """(toggles to turn on, roles Blender cannot provide) for needs() = {"required", "optional"}."""
+    roles = list(needs["required"]) + list(needs["optional"])
     on = {ROLE_TOGGLES[r] for r in roles if r in ROLE_TOGGLES}
     unavailable = [r for r in roles if r not in ROLE_TOGGLES and r not in BUILTIN_ROLES]
     return on, unavailable
 
 
-def apply(scene, info, log=print):
-    """Enables exactly the passes the filter needs on every view layer of the scene and turns
-    Cycles' own denoiser off. Returns the messages it logged."""
+def apply(scene, filter_name, needs, log=print):
+    """Enables exactly the passes the filter's settings need or use (needs: the native module's
+    needs()) on every view layer of the scene and turns Cycles' own denoiser off. Returns the
+    messages it logged."""
     messages = []
-    on, unavailable = wanted_toggles(info)
+    on, unavailable = wanted_toggles(needs)
     for vl in scene.view_layers:
         for toggle in ROLE_TOGGLES.values():
             owner = _owner(vl, toggle[0])
             if owner is not None and hasattr(owner, toggle[1]):
                 setattr(owner, toggle[1], toggle in on)
     names = sorted(("cycles." if o else "") + a for o, a in on)
-    messages.append(f"mcrecon: filter '{info['name']}' passes: combined"
+    messages.append(f"mcrecon: filter '{filter_name}' passes: combined"
                     + (", " + ", ".join(names) if names else " only"))
     if unavailable:
         messages.append(f"mcrecon: Blender does not render {', '.join(unavailable)}; "
-                        f"'{info['name']}' runs without them")
+                        f"'{filter_name}' runs without them")
     if hasattr(scene, "cycles") and scene.cycles.use_denoising:
         scene.cycles.use_denoising = False
         messages.append("mcrecon: turned off Cycles denoising (scene.cycles.use_denoising); "

@@ -20,18 +20,18 @@ def prop_name(param):
 
 def _property(spec):
     t, desc = spec["type"], spec["help"]
+    common = dict(name=spec["name"], description=desc, update=_on_param_change)
     if t == "int":
         lo, hi = max(int(spec["min"]), -INT32), min(int(spec["max"]), INT32)
-        return bpy.props.IntProperty(name=spec["name"], description=desc, default=int(spec["default"]),
-                                     min=lo, max=hi)
+        return bpy.props.IntProperty(default=int(spec["default"]), min=lo, max=hi, **common)
     if t == "float":
-        return bpy.props.FloatProperty(name=spec["name"], description=desc, default=float(spec["default"]),
-                                       min=float(spec["min"]), max=float(spec["max"]), precision=4)
+        return bpy.props.FloatProperty(default=float(spec["default"]), min=float(spec["min"]),
+                                       max=float(spec["max"]), precision=4, **common)
     if t == "bool":
-        return bpy.props.BoolProperty(name=spec["name"], description=desc, default=bool(spec["default"]))
+        return bpy.props.BoolProperty(default=bool(spec["default"]), **common)
     if t == "enum":
         items = [(c, c, desc) for c in spec["choices"]]
-        return bpy.props.EnumProperty(name=spec["name"], description=desc, items=items, default=spec["default"])
+        return bpy.props.EnumProperty(items=items, default=spec["default"], **common)
     raise ValueError(f"parameter {spec['name']}: unknown type {t}")
 
 
@@ -75,10 +75,45 @@ def filter_params(settings, filter_name):
     return out
 
 
+def needs(settings):
+    """What the scene's filter settings (parameters, extra parameters, accumulate) need and use:
+    the native module's needs(). Raises mcrecon.Error for bad settings."""
+    return native.get().needs(settings.filter, filter_params(settings, settings.filter),
+                              accumulate=settings.accumulate)
+
+
+def apply_passes(scene, log=print):
+    """Enables the passes the scene's settings need or use (passes.apply); returns its messages.
+    Raises mcrecon.Error for bad settings (nothing is changed then)."""
+    settings = scene.mcrecon
+    return passes.apply(scene, settings.filter, needs(settings), log)
+
+
+def _apply_or_report(scene):
+    mc = native.get()
+    try:
+        apply_passes(scene)
+    except mc.Error as e:
+        line = f"mcrecon: ERROR: passes not changed: {e} [{e.kind}]"
+        print(line, flush=True)
+        scene.mcrecon.last_message = line
+
+
 def _on_filter_change(self, context):
+    scene = self.id_data
     if self.enabled:
-        passes.apply(context.scene, native.get().filter_info(self.filter))
-    pass_output.ensure(context.scene)
+        _apply_or_report(scene)
+    pass_output.ensure(scene)
+
+
+def _on_param_change(self, context):
+    """A parameter of a filter group changed: the chosen filter's needs may have too."""
+    scene = self.id_data
+    settings = scene.mcrecon
+    chosen = getattr(settings, group_attr(settings.filter))
+    if settings.enabled and chosen.as_pointer() == self.as_pointer():
+        _apply_or_report(scene)
+        pass_output.ensure(scene)  # its File Output node links the passes now on
 
 
 def _base_annotations():
@@ -89,8 +124,13 @@ def _base_annotations():
         "output_path": bpy.props.StringProperty(
             name="Output", subtype="FILE_PATH", default="",
             description="Denoised output (#### = frame); empty: <render>_denoised.exr next to the render"),
+        "accumulate": bpy.props.BoolProperty(
+            name="Accumulate", default=False, update=_on_filter_change,
+            description="Temporally accumulate the noisy colour across the frames of an animation before the "
+                        "filter (as mcrecon denoise --accumulate; needs the Position and Normal passes, uses "
+                        "Vector); history restarts on a frame jump"),
         "extra_params": bpy.props.StringProperty(
-            name="Extra parameters", default="",
+            name="Extra parameters", default="", update=_on_filter_change,
             description="Advanced: KEY=VALUE pairs passed to the filter as they are (like mcrecon denoise --set)"),
         "last_message": bpy.props.StringProperty(name="Last message", default=""),
     }

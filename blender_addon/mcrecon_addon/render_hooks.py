@@ -3,8 +3,10 @@ filter (on the compositor's Combined when compositing is on, else the raw Combin
 denoised EXR and load it as the image "mcrecon Result".
 
 One native Session per render job (render_init .. render_complete/render_cancel), so temporal
-filters (bmfr) see the frames of an animation in order, with their history. Errors become
-console messages and scene.mcrecon.last_message; they never stop Blender writing the render."""
+filters (bmfr) and the accumulation stage (scene.mcrecon.accumulate) see the frames of an animation
+in order, with their history; a frame that does not follow the last one denoised (a frame jump,
+frame_step > 1, or a frame after a failed one) starts a fresh history. Errors become console
+messages and scene.mcrecon.last_message; they never stop Blender writing the render."""
 import os
 import re
 
@@ -14,7 +16,7 @@ from bpy.app.handlers import persistent
 from . import native, pass_output, properties
 
 RESULT_IMAGE = "mcrecon Result"
-_job = {"session": None, "key": None}
+_job = {"session": None, "key": None, "next": None}  # next: the frame that continues the history
 
 
 def log(scene, text, error=False):
@@ -76,10 +78,9 @@ def _session(scene):
     mc = native.get()
     settings = scene.mcrecon
     params = properties.filter_params(settings, settings.filter)
-    key = (settings.filter, tuple(sorted((k, str(v)) for k, v in params.items())))
+    key = (settings.filter, settings.accumulate, tuple(sorted((k, str(v)) for k, v in params.items())))
     if _job["session"] is None or _job["key"] != key:
-        _job["session"] = mc.Session(settings.filter, params)
-        _job["key"] = key
+        _job.update(session=mc.Session(settings.filter, params, accumulate=settings.accumulate), key=key, next=None)
     return _job["session"]
 
 
@@ -108,6 +109,10 @@ def denoise_render(scene, source, render_path):
             log(scene, f"pass file '{source}' was not written", error=True)
             return None
         session = _session(scene)
+        frame = scene.frame_current
+        if session.temporal and frame != _job["next"]:
+            session.reset()  # a frame jump (or the first frame): no history carried over
+        _job["next"] = None  # until this frame is done
         out = output_for(scene, render_path)
         layer = pass_output.view_layer(scene).name
         passes = {}
@@ -120,9 +125,10 @@ def denoise_render(scene, source, render_path):
                 raise
             log(scene, "no Composite.Combined in the render: denoising the raw Combined")
             t = session.denoise_file(source, out, layer=layer)
-        log(scene, f"{session.filter} frame {scene.frame_current}: {out} "
+        _job["next"] = frame + 1
+        log(scene, f"{session.filter}{' (accumulated)' if session.accumulate else ''} frame {frame}: {out} "
                    f"({t['filter_ms']:.0f} ms filter, {t['total_ms']:.0f} ms total)")
-        for note in session.notes:
+        for note in session.notes():
             log(scene, note)
         _load_result(out)
         return out
@@ -135,7 +141,7 @@ def denoise_render(scene, source, render_path):
 
 @persistent
 def on_render_init(scene, *args):
-    _job.update(session=None, key=None)
+    _job.update(session=None, key=None, next=None)
     if getattr(scene, "mcrecon", None) is not None:
         pass_output.ensure(scene)  # background / main thread; the UI sets it up on filter change
 
@@ -163,7 +169,7 @@ def on_render_write(scene, *args):
 
 @persistent
 def on_render_complete(scene, *args):
-    _job.update(session=None, key=None)
+    _job.update(session=None, key=None, next=None)
 
 
 _handlers = (

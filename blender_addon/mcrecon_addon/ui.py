@@ -19,6 +19,7 @@ class MCRECON_PT_render(bpy.types.Panel):
         mc = context.scene.mcrecon
         layout.active = mc.enabled
         layout.prop(mc, "filter")
+        layout.prop(mc, "accumulate")
         info = native.get().filter_info(mc.filter)
         layout.label(text=info["summary"])
         group = getattr(mc, properties.group_attr(mc.filter))

@@ -98,6 +98,20 @@ KeyValues params_from_dict(const py::dict& params) {
   return kv;
 }
 
+// accumulate=: True/False (numpy.bool_ too), or the ints 0 and 1; anything else is an
+// error naming the setting and what was given.
+bool switch_from_py(const char* name, const py::handle& v) {
+  const bool is_bool = py::isinstance<py::bool_>(v) ||
+                       (py::hasattr(v, "dtype") && py::str(v.attr("dtype")).cast<std::string>() == "bool");
+  if (is_bool) return py::bool_(py::reinterpret_borrow<py::object>(v)).cast<bool>();
+  if (py::isinstance<py::int_>(v)) {
+    const long long i = v.cast<long long>();
+    if (i == 0 || i == 1) return i == 1;
+  }
+  throw mcr::Error(Errc::InvalidArgument, std::string(name) + " expects True or False, got " +
+                                              py::repr(v).cast<std::string>());
+}
+
 std::vector<mcr::PassOverride> overrides_from_dict(const py::dict& passes) {
   std::vector<mcr::PassOverride> out;
   for (const auto& item : passes) {
@@ -199,6 +213,23 @@ py::array_t<float> to_numpy(mcr::Image img) {
                             holder->data(), owner);
 }
 
+// {"required": [...], "optional": [...], "why": {role: setting}} (why: the required
+// passes that a setting needs, e.g. {"albedo": "demodulate"}).
+py::dict needs_dict(const mcr::PassNeeds& n) {
+  py::list req, opt;
+  py::dict why;
+  for (std::size_t i = 0; i < n.required.size(); ++i) {
+    req.append(mcr::role_name(n.required[i]));
+    if (!n.why[i].empty()) why[mcr::role_name(n.required[i])] = n.why[i];
+  }
+  for (Role r : n.optional) opt.append(mcr::role_name(r));
+  py::dict d;
+  d["required"] = req;
+  d["optional"] = opt;
+  d["why"] = why;
+  return d;
+}
+
 py::dict times_dict(const mcr::StageTimes& t) {
   py::dict d;
   d["read_ms"] = t.read_ms;
@@ -210,21 +241,24 @@ py::dict times_dict(const mcr::StageTimes& t) {
 
 // ------------------------------------------------------------------ Session
 
-// One filter, committed once, with its temporal history kept across calls.
+// One reconstruction (optional accumulation stage + a filter committed once), with
+// its temporal history kept across calls.
 class Session {
  public:
-  Session(const std::string& filter, const py::dict& params, int threads)
-      : session_(filter, params_from_dict(params)), threads_(threads) {}
+  Session(const std::string& filter, const py::dict& params, int threads, const py::handle& accumulate)
+      : session_(filter, params_from_dict(params), switch_from_py("accumulate", accumulate)), threads_(threads) {}
 
   std::string name() { return session_.filter().info().name; }
-  bool temporal() { return session_.filter().info().temporal; }
+  bool temporal() { return session_.reconstruction().temporal(); }
+  bool accumulates() { return session_.reconstruction().accumulates(); }
   py::dict params() {
     py::dict d;
     for (const auto& kv : session_.filter().params().values()) d[py::str(kv.first)] = value_to_py(kv.second);
     return d;
   }
-  std::vector<std::string> notes() { return session_.filter().notes(); }
-  void reset() { session_.filter().reset(); }
+  py::dict needs() { return needs_dict(session_.reconstruction().needs()); }
+  std::vector<std::string> notes() { return session_.reconstruction().notes(); }
+  void reset() { session_.reconstruction().reset(); }
 
   py::array_t<float> denoise(const ArrayPasses& a, const std::optional<std::vector<int>>& roi) {
     const mcr::Frame frame = frame_from_arrays(a);
@@ -232,7 +266,7 @@ class Session {
     mcr::Image out;
     {
       py::gil_scoped_release release;
-      out = session_.filter().execute(frame, eo);
+      out = session_.reconstruction().run(frame, eo);
     }
     return to_numpy(std::move(out));
   }
@@ -302,12 +336,16 @@ PYBIND11_MODULE(mcrecon, m) {
 
   py::class_<Session>(m, "Session",
                       "A committed filter that keeps temporal history across calls (one per shot / animation).")
-      .def(py::init<const std::string&, const py::dict&, int>(), py::arg("filter"), py::arg("params") = py::dict(),
-           py::arg("threads") = 0)
+      .def(py::init<const std::string&, const py::dict&, int, const py::handle&>(), py::arg("filter"),
+           py::arg("params") = py::dict(), py::arg("threads") = 0, py::kw_only(), py::arg("accumulate") = false,
+           "accumulate=True: the temporal accumulation stage (`mcrecon denoise --accumulate`) before the filter")
       .def_property_readonly("filter", &Session::name)
-      .def_property_readonly("temporal", &Session::temporal)
+      .def_property_readonly("temporal", &Session::temporal, "frame order matters (temporal filter or accumulate)")
+      .def_property_readonly("accumulate", &Session::accumulates)
       .def_property_readonly("params", &Session::params, "every parameter value (defaults filled in)")
-      .def_property_readonly("notes", &Session::notes, "notes from the last run")
+      .def("needs", &Session::needs, "the passes these settings need and use, as mcrecon.needs()")
+      .def("notes", &Session::notes,
+           "settings given that have no effect, then the notes of the last run (filter, accumulation)")
       .def("reset", &Session::reset, "drop temporal history (new shot)")
       .def(
           "denoise",
@@ -331,8 +369,9 @@ PYBIND11_MODULE(mcrecon, m) {
       "denoise",
       [](const std::string& filter, py::object colour, py::object albedo, py::object normal, py::object position,
          py::object depth, py::object motion, py::object variance, py::object sample_count, py::object alpha,
-         const std::string& normal_space, const py::dict& params, int threads, const std::optional<std::vector<int>>& roi) {
-        Session s(filter, params, threads);
+         const std::string& normal_space, const py::dict& params, int threads, const std::optional<std::vector<int>>& roi,
+         const py::object& accumulate) {
+        Session s(filter, params, threads, accumulate);
         return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
                          roi);
       },
@@ -340,26 +379,28 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("position") = py::none(), py::arg("depth") = py::none(), py::arg("motion") = py::none(),
       py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
       py::arg("normal_space") = "world", py::arg("params") = py::dict(), py::arg("threads") = 0,
-      py::arg("roi") = py::none(),
+      py::arg("roi") = py::none(), py::arg("accumulate") = false,
       "Filters one frame given as float32 H x W x C numpy arrays (colour RGB or RGBA, features as available); "
       "returns H x W x 3 float32.");
 
   m.def(
       "denoise_file",
       [](const std::string& input, const std::string& output, const std::string& filter, const py::dict& params,
-         const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads) {
-        Session s(filter, params, threads);
+         const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads,
+         const py::object& accumulate) {
+        Session s(filter, params, threads, accumulate);
         return s.denoise_file(input, output, layer, passes, keep_passes);
       },
       py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
       py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
-      py::arg("threads") = 0, "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...`.");
+      py::arg("threads") = 0, py::arg("accumulate") = false,
+      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate).");
 
   m.def(
       "denoise_sequence",
       [](const std::string& input, const std::string& output, int first, int last, const std::string& filter,
          const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
-         const std::optional<std::function<void(int, int, std::string)>>& progress) {
+         const std::optional<std::function<void(int, int, std::string)>>& progress, const py::object& accumulate) {
         if (!mcr::is_sequence_pattern(input) || !mcr::is_sequence_pattern(output))
           throw mcr::Error(Errc::InvalidArgument, "input and output must be sequence patterns (#### or %04d)");
         if (last < first) throw mcr::Error(Errc::InvalidArgument, "frame range " + std::to_string(first) + "-" +
@@ -370,7 +411,7 @@ PYBIND11_MODULE(mcrecon, m) {
           if (!std::filesystem::exists(in, ec))
             throw mcr::Error(Errc::FileNotFound, "cannot read '" + in + "': no such file");
         }
-        Session s(filter, params, threads);
+        Session s(filter, params, threads, accumulate);
         py::list outputs;
         for (int f = first; f <= last; ++f) {
           const std::string out = mcr::sequence_path(output, f);
@@ -382,7 +423,20 @@ PYBIND11_MODULE(mcrecon, m) {
       },
       py::arg("input"), py::arg("output"), py::arg("first"), py::arg("last"), py::arg("filter"),
       py::arg("params") = py::dict(), py::arg("layer") = py::none(), py::arg("passes") = py::dict(),
-      py::arg("threads") = 0, py::arg("progress") = py::none(),
-      "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history); "
-      "progress(done, total, output) is called after each frame. Returns the outputs written.");
+      py::arg("threads") = 0, py::arg("progress") = py::none(), py::arg("accumulate") = false,
+      "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history; "
+      "accumulate=True as --accumulate); progress(done, total, output) is called after each frame. Returns the "
+      "outputs written.");
+
+  m.def(
+      "needs",
+      [](const std::string& filter, const py::dict& params, const py::object& accumulate) {
+        const mcr::Reconstruction r(mcr::make_committed_filter(filter, params_from_dict(params)),
+                                    switch_from_py("accumulate", accumulate));
+        return needs_dict(r.needs());
+      },
+      py::arg("filter"), py::arg("params") = py::dict(), py::arg("accumulate") = false,
+      "The passes a filter needs with these settings (and accumulate): {'required': [role, ...], "
+      "'optional': [role, ...], 'why': {role: the setting that requires it}}; parameter errors raise "
+      "mcrecon.Error as Session does.");
 }

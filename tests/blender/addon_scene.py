@@ -85,6 +85,13 @@ def case_render(filter_name):
     result["ref"] = written(scene)
 
 
+def roles(filter_name, params=None, accumulate=False):
+    """The roles needs() names for these settings, required and optional."""
+    import mcrecon_addon.native as native
+    n = native.get().needs(filter_name, params or {}, accumulate=accumulate)
+    return n["required"] + n["optional"]
+
+
 def case_passes():
     scene = room_scene()
     import mcrecon_addon.native as native
@@ -100,9 +107,25 @@ def case_passes():
             (abs(getattr(group, s["name"]) - s["default"]) <= 1e-6 * max(1, abs(s["default"])))
             if s["type"] == "float" else getattr(group, s["name"]) == s["default"]
             for s in info["parameters"])
-        seen[info["name"]] = {"toggles": toggles(scene), "defaults_ok": defaults_ok,
-                              "roles": info["required_passes"] + info["optional_passes"]}
+        seen[info["name"]] = {"toggles": toggles(scene), "defaults_ok": defaults_ok, "roles": roles(info["name"])}
     result["filters"] = seen
+    # Settings other than the defaults: the toggles follow needs() of the chosen settings as
+    # they change (a parameter of the chosen filter, accumulate), through the panel's properties.
+    settings = {}
+
+    def switched_on(owner, prop, label, filter_name, params=None, accumulate=False):
+        """Records the toggles with owner.prop = True (needs() of the settings given), then undoes it."""
+        setattr(owner, prop, True)
+        settings[label] = {"toggles": toggles(scene), "roles": roles(filter_name, params, accumulate)}
+        setattr(owner, prop, False)
+    for name in ("box", "bilateral"):
+        mc.filter = name
+        settings[name] = {"toggles": toggles(scene), "roles": roles(name)}
+        switched_on(getattr(mc, "params_" + name), "demodulate", name + " demodulate", name, {"demodulate": True})
+    switched_on(mc, "accumulate", "bilateral accumulate", "bilateral", accumulate=True)
+    mc.filter = "box"
+    switched_on(mc, "accumulate", "box accumulate", "box", accumulate=True)
+    result["settings"] = settings
     # The panel draws every parameter of the chosen filter (recorded by a stand-in layout).
     drawn = []
 
@@ -129,7 +152,8 @@ def case_passes():
     result["after_operator_box"] = toggles(scene)
 
 
-def case_anim():
+def anim_scene(filter_name, accumulate=False):
+    """The anim sample scene at test size, frames 1-4, with the add-on on."""
     import anim
     scene = anim.build()
     vl = C.configure_render(scene, W, H)
@@ -137,11 +161,24 @@ def case_anim():
     scene.frame_start, scene.frame_end = 1, 4
     mc = scene.mcrecon
     mc.enabled = True
-    mc.filter = "bmfr"
-    mc.output_path = os.path.join(OUT, "den_####.exr")
-    result["anim_seconds"] = render(scene, os.path.join(OUT, "anim_####"), 4, 7, animation=True)
-    result["renders"] = [scene.render.frame_path(frame=f) for f in range(1, 5)]
-    result["outputs"] = [os.path.join(OUT, "den_%04d.exr" % f) for f in range(1, 5)]
+    mc.filter = filter_name
+    mc.accumulate = accumulate  # switches on the passes accumulation needs (position, normal; vector)
+    return scene
+
+
+def render_anim(scene, name, frames):
+    """Renders the animation as OUT/<name>_####.exr, denoised to OUT/<name>_den_####.exr; returns
+    (seconds, renders, outputs) of `frames`."""
+    scene.mcrecon.output_path = os.path.join(OUT, name + "_den_####.exr")
+    seconds = render(scene, os.path.join(OUT, name + "_####"), 4, 7, animation=True)
+    return (seconds, [scene.render.frame_path(frame=f) for f in frames],
+            [os.path.join(OUT, name + "_den_%04d.exr" % f) for f in frames])
+
+
+def case_anim():
+    scene = anim_scene("bmfr")
+    mc = scene.mcrecon
+    result["anim_seconds"], result["renders"], result["outputs"] = render_anim(scene, "anim", range(1, 5))
     result["message"] = mc.last_message
     # Re-denoise the saved sequence with the operator.
     mc.enabled = False
@@ -150,6 +187,29 @@ def case_anim():
                                       frame_start=1, frame_end=4, filter="bmfr")
     result["operator"] = sorted(r)
     result["redo"] = [os.path.join(OUT, "redo_%04d.exr" % f) for f in range(1, 5)]
+
+
+def case_anim_accumulate():
+    """An animation render with box + accumulate, then one with a frame jump (frame_step 2), then
+    the operator on frames 1-4 of the anim sample sequence (samples/data)."""
+    scene = anim_scene("box", accumulate=True)
+    mc = scene.mcrecon
+    result["toggles"] = toggles(scene)
+    _, result["renders"], result["outputs"] = render_anim(scene, "anim", range(1, 5))
+    result["message"] = mc.last_message
+    # Frames 1 and 3: 3 does not follow 1, so its history starts fresh.
+    scene.frame_start, scene.frame_end, scene.frame_step = 1, 3, 2
+    _, result["step_renders"], result["step_outputs"] = render_anim(scene, "step", (1, 3))
+    result["step_message"] = mc.last_message
+    scene.frame_step = 1
+    # The operator takes accumulate from the scene (invoke) or as its own property.
+    mc.enabled = False
+    sample = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_####.exr")
+    r = bpy.ops.mcrecon.denoise_files(filepath=sample, output=os.path.join(OUT, "op_####.exr"),
+                                      frame_start=1, frame_end=4, filter="box", accumulate=True)
+    result["operator"] = sorted(r)
+    result["sample"] = sample
+    result["op_outputs"] = [os.path.join(OUT, "op_%04d.exr" % f) for f in range(1, 5)]
 
 
 def case_errors():
@@ -208,7 +268,8 @@ def case_install_zip():
 
 enable_addon()
 {"render_box": lambda: case_render("box"), "render_bilateral": lambda: case_render("bilateral"),
- "passes": case_passes, "anim_bmfr": case_anim, "errors": case_errors,
+ "passes": case_passes, "anim_bmfr": case_anim, "anim_accumulate": case_anim_accumulate,
+ "errors": case_errors,
  "composite": case_composite, "install_zip": case_install_zip}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

@@ -2,7 +2,7 @@
 addon_scene.py, then checks exit status, files, console messages and image error.
 
     /usr/bin/python3 blender_case.py CASE      (render_box, render_bilateral, passes, anim_bmfr,
-                                                errors, composite, install_zip)
+                                                anim_accumulate, errors, composite, install_zip)
 Environment: MCRECON_BLENDER, MCRECON_SOURCE_DIR, MCRECON_ADDON_STAGE, MCRECON_ADDON_ZIP,
 MCRECON_TEST_TMP. Exit 77 = skipped (ctest SKIP_RETURN_CODE).
 """
@@ -78,9 +78,9 @@ def cli():
     return path
 
 
-def cli_denoise(src, out, filter_name, *sets):
+def cli_denoise(src, out, filter_name, *sets, extra=()):
     """`mcrecon denoise` on a saved render, reading the view layer the add-on reads."""
-    args = [cli(), "denoise", src, "-o", out, "-f", filter_name, "--layer", "ViewLayer"]
+    args = [cli(), "denoise", src, "-o", out, "-f", filter_name, "--layer", "ViewLayer", *extra]
     for s in sets:
         args += ["--set", s]
     p = subprocess.run(args, capture_output=True, text=True, timeout=120)
@@ -139,12 +139,25 @@ def check_passes():
     r, log = run_blender()
     assert r["cycles_denoising"] is False
     role_toggles = r["role_toggles"]
+
+    def on_and_wanted(f):
+        return {k for k, v in f["toggles"].items() if v}, {role_toggles[x] for x in f["roles"] if x in role_toggles}
     for name, f in r["filters"].items():
-        want = {role_toggles[x] for x in f["roles"] if x in role_toggles}
-        on = {k for k, v in f["toggles"].items() if v}
-        assert on == want, f"{name}: passes on {sorted(on)}, needs {sorted(want)}"
+        on, want = on_and_wanted(f)
+        assert on == want, f"{name}: passes on {sorted(on)}, needs() says {sorted(want)}"
         assert f["defaults_ok"], f"{name}: a generated property's default differs from the table"
         print(f"{name}: {sorted(on) or 'combined only'}")
+    seen = {}
+    for label, f in r["settings"].items():
+        on, want = on_and_wanted(f)
+        assert on == want, f"{label}: passes on {sorted(on)}, needs() says {sorted(want)}"
+        seen[label] = on
+        print(f"{label}: {sorted(on) or 'combined only'}")
+    # The settings change the passes (else the checks above would hold for a static list).
+    assert seen["box"] == set() and seen["box demodulate"] == {"cycles.denoising_store_passes"}, seen
+    assert {"use_pass_position", "use_pass_normal", "use_pass_vector"} <= seen["box accumulate"], seen
+    assert seen["bilateral demodulate"] != seen["box"], seen
+    assert "use_pass_vector" in seen["bilateral accumulate"] - seen["bilateral"], seen
     assert not any(r["filters"]["box"]["toggles"].values()), "box needs no feature pass"
     if "bilateral" in r["filters"]:
         t = r["filters"]["bilateral"]["toggles"]
@@ -172,6 +185,54 @@ def check_anim():
     for a, b in zip(r["outputs"], r["redo"]):
         assert np.array_equal(rgb(a), rgb(b)), f"{a} and {b} differ"
     print(f"bmfr: 4 frames rendered and denoised in {r['anim_seconds']:.1f} s; operator matches")
+
+
+def check_anim_accumulate():
+    """The render hook and the operator with accumulate equal `mcrecon denoise --accumulate` of the
+    same frames bit for bit, differ from the plain filter, and a frame jump starts fresh."""
+    r, log = run_blender()
+    for p in r["renders"] + r["outputs"] + r["step_renders"] + r["step_outputs"] + r["op_outputs"]:
+        assert os.path.exists(p), f"missing {p}\n{log[-3000:]}"
+    for key in ("message", "step_message"):
+        assert "ERROR" not in r[key], r[key]
+    assert r["toggles"]["use_pass_position"] and r["toggles"]["use_pass_normal"], r["toggles"]
+    assert r["operator"] == ["FINISHED"], r["operator"]
+
+    def same(a, b):
+        (na, pa), (nb, pb) = all_channels(a), all_channels(b)
+        return na == nb and np.array_equal(pa.view(np.uint32), pb.view(np.uint32))
+
+    def sequence(renders, name, accumulate):
+        """`mcrecon denoise [--accumulate] --frames 1-N` of the given renders, copied as one sequence."""
+        seq = os.path.join(OUT, name)
+        os.makedirs(seq, exist_ok=True)
+        for n, src in enumerate(renders, 1):
+            shutil.copyfile(src, os.path.join(seq, "in_%04d.exr" % n))
+        out = os.path.join(seq, "out_####.exr")
+        cli_denoise(os.path.join(seq, "in_####.exr"), out, "box",
+                    extra=["--frames", f"1-{len(renders)}"] + (["--accumulate"] if accumulate else []))
+        return [out.replace("####", "%04d" % n) for n in range(1, len(renders) + 1)]
+    want = sequence(r["renders"], "cli_acc", True)
+    plain = sequence(r["renders"], "cli_plain", False)
+    for n, (got, w, p) in enumerate(zip(r["outputs"], want, plain), 1):
+        assert same(got, w), f"render frame {n}: the add-on's output differs from `mcrecon denoise --accumulate`"
+        if n > 1:
+            assert not same(w, p), f"frame {n}: --accumulate gives the plain filter's pixels"
+    # The jump 1 -> 3: frame 3 on its own, not frame 3 continuing frame 1's history.
+    fresh = cli_denoise(r["step_renders"][1], os.path.join(OUT, "fresh_0003.exr"), "box", extra=["--accumulate"])
+    continued = sequence(r["step_renders"], "cli_continued", True)[1]
+    assert not same(fresh, continued), "the frame-jump check cannot tell a reset from a continued history"
+    assert same(r["step_outputs"][1], fresh), "frame 3 after frame 1 kept the history: no reset on a frame jump"
+    # The operator on the sample sequence.
+    seq = os.path.join(OUT, "cli_sample_####.exr")
+    p = subprocess.run([cli(), "denoise", r["sample"], "-o", seq, "-f", "box", "--frames", "1-4", "--accumulate"],
+                       capture_output=True, text=True, timeout=300)
+    assert p.returncode == 0, p.stderr
+    for n, got in enumerate(r["op_outputs"], 1):
+        assert same(got, seq.replace("####", "%04d" % n)), f"operator frame {n} differs from --accumulate"
+    assert log.count("mcrecon: box (accumulated) frame") == 6, log[-3000:]
+    print("accumulate: render hook (4 frames), frame jump reset and operator (anim sample 1-4) match "
+          "`mcrecon denoise --accumulate` bit for bit")
 
 
 def check_errors():
@@ -219,6 +280,7 @@ def check_install_zip():
 
 {"render_box": lambda: check_render("box"),
  "render_bilateral": lambda: check_render("bilateral", box_radius=bilateral_radius()),
- "passes": check_passes, "anim_bmfr": check_anim, "errors": check_errors,
+ "passes": check_passes, "anim_bmfr": check_anim, "anim_accumulate": check_anim_accumulate,
+ "errors": check_errors,
  "composite": check_composite, "install_zip": check_install_zip}[CASE]()
 print("OK")

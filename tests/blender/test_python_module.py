@@ -3,6 +3,10 @@
 - filters() matches `mcrecon filters --json` exactly;
 - box and bilateral on numpy arrays read from samples/data/room/room_16spp.exr (OpenImageIO)
   match `mcrecon denoise` bit for bit; denoise_file and Session do too;
+- accumulate=True (Session on files and arrays, denoise_file, denoise_sequence) over frames 1-4 of
+  the anim sample matches `mcrecon denoise --accumulate` bit for bit (and differs from the plain run);
+- needs() agrees with `mcrecon info --json` (which filters can run, which passes they use) and
+  changes with the settings; Session.notes() holds the unused setting `--verbose` prints;
 - errors raise mcrecon.Error naming the parameter / filter / pass, with .kind.
 Environment: MCRECON_BIN, MCRECON_SOURCE_DIR, MCRECON_PYTHON_DIR (the module's folder).
 """
@@ -22,12 +26,13 @@ import mcrecon  # noqa: E402
 SRC = os.environ["MCRECON_SOURCE_DIR"]
 BIN = os.environ["MCRECON_BIN"]
 ROOM = os.path.join(SRC, "samples", "data", "room", "room_16spp.exr")
+ANIM = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_####.exr")
 
 
-def cli(*args):
+def cli(*args, stderr=False):
     p = subprocess.run([BIN, *args], capture_output=True, text=True, timeout=300)
     assert p.returncode == 0, f"mcrecon {' '.join(args)} exited {p.returncode}: {p.stderr}"
-    return p.stdout
+    return p.stderr if stderr else p.stdout
 
 
 def read_channels(path):
@@ -101,6 +106,107 @@ def test_arrays_match_cli(tmp):
         print(f"{filt}: arrays, denoise_file and Session match `mcrecon denoise` bit for bit")
 
 
+def frame_path(pattern, f):
+    return pattern.replace("####", "%04d" % f)
+
+
+def same_bits(a, b):
+    return a.shape == b.shape and np.array_equal(a.view(np.uint32), b.view(np.uint32))
+
+
+def test_accumulate_matches_cli(tmp):
+    frames = range(1, 5)
+    want, plain = os.path.join(tmp, "acc_cli_####.exr"), os.path.join(tmp, "plain_cli_####.exr")
+    cli("denoise", ANIM, "-o", want, "-f", "box", "--frames", "1-4", "--accumulate")
+    cli("denoise", ANIM, "-o", plain, "-f", "box", "--frames", "1-4")
+    wanted = [read_channels(frame_path(want, f))[1] for f in frames]
+    for f in frames[1:]:  # so a module that drops accumulate=True fails below
+        assert not same_bits(wanted[f - 1], read_channels(frame_path(plain, f))[1]), \
+            f"frame {f}: --accumulate gives the plain filter's pixels"
+
+    # Session on files.
+    s = mcrecon.Session("box", accumulate=True)
+    assert s.accumulate and s.temporal and not mcrecon.Session("box").temporal
+    for f in frames:
+        out = frame_path(os.path.join(tmp, "acc_session_####.exr"), f)
+        s.denoise_file(frame_path(ANIM, f), out)
+        assert same_bits(read_channels(out)[1], wanted[f - 1]), f"Session(accumulate=True) frame {f} differs"
+    # denoise_sequence.
+    outs = mcrecon.denoise_sequence(ANIM, os.path.join(tmp, "acc_seq_####.exr"), 1, 4, "box", accumulate=True)
+    for f, out in zip(frames, outs):
+        assert same_bits(read_channels(out)[1], wanted[f - 1]), f"denoise_sequence(accumulate=True) frame {f} differs"
+    # Session on arrays: colour, alpha and what the accumulation reads (world position and
+    # normal, motion).
+    s = mcrecon.Session("box", accumulate=True)
+    for f in frames:
+        names, px = read_channels(frame_path(ANIM, f))
+        L = "ViewLayer"
+        got = s.denoise(group(names, px, L + ".Combined", "RGB"), alpha=group(names, px, L + ".Combined", "A"),
+                        position=group(names, px, L + ".Position", "XYZ"),
+                        normal=group(names, px, L + ".Normal", "XYZ"), motion=group(names, px, L + ".Vector", "XYZW"))
+        onames = read_channels(frame_path(want, f))[0]
+        ref = np.ascontiguousarray(wanted[f - 1][:, :, [onames.index(c) for c in "RGB"]])
+        assert same_bits(got, ref), f"Session(accumulate=True).denoise on arrays, frame {f} differs"
+    # denoise_file: one frame, as `mcrecon denoise FILE --accumulate`.
+    one = os.path.join(tmp, "acc_one.exr")
+    cli("denoise", frame_path(ANIM, 2), "-o", one, "-f", "box", "--accumulate")
+    mine = os.path.join(tmp, "acc_one_py.exr")
+    mcrecon.denoise_file(frame_path(ANIM, 2), mine, "box", accumulate=True)
+    assert same_bits(read_channels(mine)[1], read_channels(one)[1]), "denoise_file(accumulate=True) differs"
+    print("accumulate=True: Session (files, arrays), denoise_sequence, denoise_file match `mcrecon denoise "
+          "--accumulate` bit for bit")
+
+
+def test_needs_match_info_and_settings(tmp):
+    # `mcrecon info` says which filters can run with their defaults: needs() of the defaults. A
+    # colour-only file lacks what some filters require; its sample count is a pass the defaults
+    # use (the hole fill) that no filter's static list names.
+    only_colour = os.path.join(tmp, "colour_only.exr")
+    spec = oiio.ImageSpec(16, 12, 5, "float")
+    spec.channelnames = ("R", "G", "B", "A", "sample_count.Y")
+    out = oiio.ImageOutput.create(only_colour)
+    assert out.open(only_colour, spec) and out.write_image(np.full((12, 16, 5), 1.0, np.float32)), out.geterror()
+    out.close()
+    for path in (ROOM, only_colour):
+        info = json.loads(cli("info", "--json", path))
+        present = set(info["roles"])
+        assert [f["name"] for f in info["filters"]] == mcrecon.filter_names()
+        for entry in info["filters"]:
+            n = mcrecon.needs(entry["name"])
+            assert entry["missing"] == [r for r in n["required"] if r not in present], (path, entry, n)
+            assert entry["uses"] == [r for r in n["optional"] if r in present], (path, entry, n)
+            assert entry["can_run"] == (not entry["missing"])
+    colour_info = json.loads(cli("info", "--json", only_colour))
+    assert "sample_count" in colour_info["roles"], colour_info["roles"]
+    assert any(not f["can_run"] for f in colour_info["filters"])
+    assert all("sample_count" in f["uses"] for f in colour_info["filters"] if f["can_run"])
+    # Settings change what is needed.
+    box = mcrecon.needs("box")
+    assert box["required"] == ["colour"] and box["why"] == {} and "albedo" not in box["optional"], box
+    demod = mcrecon.needs("box", {"demodulate": True})
+    assert "albedo" in demod["required"] and demod["why"]["albedo"] == "demodulate=true", demod
+    acc = mcrecon.needs("box", accumulate=True)
+    assert {"position", "normal"} <= set(acc["required"]) and "motion" in acc["optional"], acc
+    assert acc["why"]["position"] == "accumulate", acc
+    assert mcrecon.Session("box", {"demodulate": True}).needs() == demod
+    assert mcrecon.Session("box", accumulate=True).needs() == acc
+    expect_error(lambda: mcrecon.needs("box", {"radius": -1}), "parameter_out_of_range", "radius")
+    print("needs(): matches `mcrecon info` on two files and follows the settings")
+
+
+def test_notes_hold_unused_settings(tmp):
+    err = cli("denoise", ROOM, "-o", os.path.join(tmp, "n.exr"), "-f", "box", "--set", "firefly_radius=5",
+              "--verbose", stderr=True)
+    notes = [l[len("mcrecon: note: "):] for l in err.splitlines() if l.startswith("mcrecon: note: ")]
+    assert notes == ["firefly_radius has no effect with firefly_k=0"], err
+    s = mcrecon.Session("box", {"firefly_radius": 5})
+    assert s.notes() == notes, s.notes()
+    s.denoise_file(ROOM, os.path.join(tmp, "n_py.exr"))
+    assert s.notes()[:1] == notes, s.notes()  # still first after a run
+    assert mcrecon.Session("box").notes() == []
+    print("Session.notes(): the unused setting `mcrecon denoise --verbose` prints")
+
+
 def test_two_threads_filter_at_once():
     c = np.random.default_rng(1).random((64, 96, 3), dtype=np.float32)
     results = [None, None]
@@ -168,6 +274,12 @@ def test_errors(tmp):
     assert missing, "bmfr requires no feature pass"
     expect_error(lambda: mcrecon.Session("bmfr").denoise(c), "missing_pass", missing[0])
     expect_error(lambda: mcrecon.filter_info("nope"), "unknown_filter", "nope")
+    for bad in ("maybe", 2):
+        expect_error(lambda: mcrecon.Session("box", accumulate=bad), "invalid_argument", "accumulate", repr(bad))
+        expect_error(lambda: mcrecon.denoise_file(ROOM, os.path.join(tmp, "o.exr"), "box", accumulate=bad),
+                     "invalid_argument", "accumulate", repr(bad))
+    # Accumulation's passes are checked before any work, naming the setting.
+    expect_error(lambda: mcrecon.Session("box", accumulate=True).denoise(c), "missing_pass", "position", "accumulate")
     print("errors: mcrecon.Error with kind and message naming filter / parameter / pass / file")
 
 
@@ -177,6 +289,9 @@ if __name__ == "__main__":
     with tempfile.TemporaryDirectory(prefix="mcrecon_py_") as tmp:
         test_filters_match_cli()
         test_arrays_match_cli(tmp)
+        test_accumulate_matches_cli(tmp)
+        test_needs_match_info_and_settings(tmp)
+        test_notes_hold_unused_settings(tmp)
         test_two_threads_filter_at_once()
         test_gil_released_while_filtering()
         test_errors(tmp)

@@ -1,5 +1,6 @@
 // The plugin's temporal-history rule (plugin/history.h) with a fake temporal
-// filter: which frames continue history and which start fresh (reset()).
+// filter inside a Reconstruction: which frames continue history and which start
+// fresh (reset()); accumulation makes a spatial filter's stream temporal.
 #include <gtest/gtest.h>
 
 #include "history.h"
@@ -39,17 +40,22 @@ class FakeFilter : public Filter {
   void run(const Frame&, const Image&, const Roi&, Image&, int) override { ++history; }
 };
 
-StreamHistory::Factory fake(bool temporal, int* made = nullptr) {
+StreamHistory::Factory fake(bool temporal, int* made = nullptr, bool accumulate = false) {
   return [=] {
     if (made) ++*made;
-    return std::unique_ptr<Filter>(new FakeFilter(temporal));
+    return std::make_unique<Reconstruction>(std::make_unique<FakeFilter>(temporal), accumulate);
   };
 }
 
+FakeFilter& fake_of(const StreamHistory::Lease& lease) {
+  return static_cast<FakeFilter&>(lease.reconstruction->filter());
+}
+
 // acquire + "run" + done, returning whether history continued.
-bool step(StreamHistory& h, const std::string& key, const std::string& path, bool temporal = true) {
-  auto lease = h.acquire(key, path, fake(temporal));
-  ++static_cast<FakeFilter*>(lease.filter)->history;
+bool step(StreamHistory& h, const std::string& key, const std::string& path, bool temporal = true,
+          bool accumulate = false) {
+  auto lease = h.acquire(key, path, fake(temporal, nullptr, accumulate));
+  ++fake_of(lease).history;
   h.done();
   return lease.continued;
 }
@@ -77,8 +83,8 @@ TEST(PluginHistory, InOrderFramesContinue) {
   }
   auto lease = h.acquire("bmfr", "a_0017.exr", fake(true));
   EXPECT_TRUE(lease.continued);
-  EXPECT_EQ(static_cast<FakeFilter*>(lease.filter)->history, 16);  // one object kept all frames
-  EXPECT_EQ(static_cast<FakeFilter*>(lease.filter)->resets, 1);    // only before frame 1
+  EXPECT_EQ(fake_of(lease).history, 16);  // one object kept all frames
+  EXPECT_EQ(fake_of(lease).resets, 1);    // only before frame 1
 }
 
 TEST(PluginHistory, GapsRepeatsAndBackwardsStartFresh) {
@@ -90,7 +96,7 @@ TEST(PluginHistory, GapsRepeatsAndBackwardsStartFresh) {
   EXPECT_FALSE(step(h, "k", "a_0003.exr"));  // backwards
   EXPECT_TRUE(step(h, "k", "a_0004.exr"));   // 3 -> 4 in order again
   auto lease = h.acquire("k", "a_0005.exr", fake(true));
-  EXPECT_EQ(static_cast<FakeFilter*>(lease.filter)->history, 2);  // frames 3 and 4 only
+  EXPECT_EQ(fake_of(lease).history, 2);  // frames 3 and 4 only
 }
 
 TEST(PluginHistory, OtherSettingsOrPatternAreOtherStreams) {
@@ -121,6 +127,17 @@ TEST(PluginHistory, NonTemporalFiltersNeverContinue) {
   StreamHistory h;
   EXPECT_FALSE(step(h, "k", "a_0001.exr", false));
   EXPECT_FALSE(step(h, "k", "a_0002.exr", false));
+}
+
+TEST(PluginHistory, AccumulationMakesASpatialFilterTemporal) {
+  StreamHistory h;
+  EXPECT_FALSE(step(h, "k accumulate=1", "a_0001.exr", false, true));
+  EXPECT_TRUE(step(h, "k accumulate=1", "a_0002.exr", false, true));
+  EXPECT_FALSE(step(h, "k accumulate=1", "a_0004.exr", false, true));  // gap: reset
+  auto lease = h.acquire("k accumulate=1", "a_0005.exr", fake(false, nullptr, true));
+  EXPECT_TRUE(lease.continued);
+  EXPECT_TRUE(lease.reconstruction->accumulates());
+  EXPECT_EQ(fake_of(lease).resets, 2);  // before frames 1 and 4: the reset reaches the filter
 }
 
 TEST(PluginHistory, OldStreamsAreDropped) {

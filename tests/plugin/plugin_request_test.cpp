@@ -55,6 +55,44 @@ TEST(PluginRequest, SortsKeysIntoFilterLayerPassesAndParameters) {
   EXPECT_EQ(make_request("o.exr", {{"filter", "box"}, {"keep_passes", "1"}}, false).params.size(), 1u);
 }
 
+TEST(PluginRequest, AccumulateOnBothSidesAndInTheSettingsKey) {
+  for (bool output_side : {false, true}) {
+    EXPECT_FALSE(make_request("r.exr", {{"filter", "box"}}, output_side).accumulate);
+    for (const char* on : {"1", "true"})
+      EXPECT_TRUE(make_request("r.exr", {{"filter", "box"}, {"accumulate", on}}, output_side).accumulate) << on;
+    for (const char* off : {"0", "false"})
+      EXPECT_FALSE(make_request("r.exr", {{"filter", "box"}, {"accumulate", "1"}, {"accumulate", off}}, output_side)
+                       .accumulate)
+          << off;  // the last one wins
+    EXPECT_TRUE(make_request("r.exr", {{"filter", "box"}, {"accumulate", "1"}}, output_side).params.empty());
+  }
+  const Request on = make_request("r.exr", {{"filter", "box"}, {"accumulate", "1"}}, false);
+  const Request off = make_request("r.exr", {{"filter", "box"}}, false);
+  EXPECT_NE(settings_key(on, "radius=2"), settings_key(off, "radius=2"));
+  EXPECT_TRUE(make_reconstruction(on)->accumulates());
+  EXPECT_FALSE(make_reconstruction(off)->accumulates());
+  EXPECT_EQ(make_reconstruction(on)->parameters_text().rfind("accumulate=true ", 0), 0u);
+}
+
+TEST(PluginRequest, BadSwitchValuesNameTheSettingAndTheText) {
+  for (const char* key : {"accumulate", "keep_passes"}) {
+    try {
+      make_request("o_0001.963d536f.temp.exr", {{"filter", "box"}, {key, "maybe"}}, true);
+      ADD_FAILURE() << key << "=maybe accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), Errc::InvalidArgument);
+      EXPECT_EQ(std::string(e.what()), std::string("'o_0001.exr': ") + key + " expects 0, 1, true or false, got 'maybe'");
+    }
+  }
+}
+
+TEST(PluginRequest, NotesTextJoinsTheNotes) {
+  EXPECT_EQ(notes_text({}), "");
+  EXPECT_EQ(notes_text({"a has no effect", "b"}), "a has no effect; b");
+  Request r = make_request("r.exr", {{"filter", "box"}, {"firefly_radius", "5"}}, false);
+  EXPECT_EQ(notes_text(make_reconstruction(r)->notes()), "firefly_radius has no effect with firefly_k=0");
+}
+
 TEST(PluginRequest, StripsOiiotoolTempNames) {
   EXPECT_EQ(strip_oiiotool_temp("/tmp/pt/o_0001.963d536f.temp.exr"), "/tmp/pt/o_0001.exr");
   EXPECT_EQ(strip_oiiotool_temp("o.ABCDEF01.temp"), "o");

@@ -6,9 +6,11 @@ MCRECON_SOURCE_DIR and MCRECON_PLUGIN_DIR (the folder holding mcrecon.imageio.so
 
 Covered: every non-temporal filter through the `?key=value` name, --iconfig and the output
 plugin (-o:fileformatname=mcrecon) on the room sample; temporal filters over an
-`oiiotool --frames 1-16` run on the anim sample (skipped when none is registered); no hang on a
-corrupt EXR; --list-formats; errors named as the CLI names them, with a non-zero exit; a read
-through OpenImageIO's Python module.
+`oiiotool --frames 1-16` run on the anim sample (skipped when none is registered); accumulate
+(`mcrecon denoise --accumulate`) over frames 1-4 of the anim sample in all three styles; the
+notes (an unused setting) as the mcreconNotes attribute; no hang on a corrupt EXR;
+--list-formats; errors named as the CLI names them, with a non-zero exit; a read through
+OpenImageIO's Python module.
 """
 import os
 import shutil
@@ -63,6 +65,16 @@ def assert_same_pixels(test, got, want, what):
         diff = np.abs(a.astype(np.float64) - b.astype(np.float64))
         test.fail("%s: plugin output differs from `mcrecon denoise` (max |diff| %g at %d pixels)"
                   % (what, np.nanmax(diff), int(np.count_nonzero(diff))))
+
+
+def header_attribute(path, name):
+    """A string attribute of an image's header (None when absent)."""
+    inp = oiio.ImageInput.open(path)
+    assert inp is not None, oiio.geterror()
+    try:
+        return inp.spec().getattribute(name)
+    finally:
+        inp.close()
 
 
 def cli_error_line(proc):
@@ -277,6 +289,83 @@ class TestMatchesCli(PluginTestBase):
                 fresh = self.path("fresh_%s.exr" % name)
                 tu.run_cli("denoise", ANIM.replace("####", "0002"), "-o", fresh, "-f", name)
                 assert_same_pixels(self, alone, fresh, "%s frame 2 on its own" % name)
+
+
+class TestAccumulate(PluginTestBase):
+    """accumulate=1 in every style equals `mcrecon denoise --accumulate` frame for frame."""
+    FRAMES = range(1, 5)
+
+    def frame(self, pattern, f):
+        return pattern.replace("####", "%04d" % f)
+
+    def test_accumulate_matches_cli_in_every_style(self):
+        want = self.path("cli_####.exr")
+        tu.run_cli("denoise", ANIM, "-o", want, "-f", "box", "--frames", "1-4", "--accumulate")
+        plain = self.path("plain_####.exr")
+        tu.run_cli("denoise", ANIM, "-o", plain, "-f", "box", "--frames", "1-4")
+        for f in self.FRAMES[1:]:  # else a plugin that drops the setting would pass
+            self.assertFalse(same_bits(tu.read_channels(self.frame(want, f), RGBA),
+                                       tu.read_channels(self.frame(plain, f), RGBA)),
+                             "frame %d: --accumulate gives the plain filter's pixels" % f)
+        styles = {
+            "?accumulate=1": ("--frames", "1-4", ANIM_OIIO + ".mcrecon?filter=box&accumulate=1", "-o"),
+            "--iconfig mcrecon:accumulate": ("--frames", "1-4", "--iconfig", "mcrecon:filter", "box",
+                                             "--iconfig:type=int", "mcrecon:accumulate", "1", ANIM_OIIO + ".mcrecon",
+                                             "-o"),
+            "--attrib mcrecon:accumulate (output plugin)": ("--frames", "1-4", ANIM_OIIO, "--attrib", "mcrecon:filter",
+                                                            "box", "--attrib", "mcrecon:accumulate", "true",
+                                                            "-o:fileformatname=mcrecon"),
+        }
+        for n, (style, args) in enumerate(styles.items()):
+            with self.subTest(style=style):
+                got = self.path("got%d_####.exr" % n)
+                check_ok(oiiotool(*args, got.replace("####", "%04d")))
+                for f in self.FRAMES:
+                    assert_same_pixels(self, self.frame(got, f), self.frame(want, f),
+                                       "box accumulate=1 frame %d (%s)" % (f, style))
+                    params = header_attribute(self.frame(got, f), "mcreconParameters")
+                    self.assertEqual(params, header_attribute(self.frame(want, f), "mcreconParameters"))
+                    self.assertTrue(params.startswith("accumulate=true "), params)
+
+    def test_bad_accumulate_value_is_named(self):
+        for args in ((ROOM + ".mcrecon?filter=box&accumulate=maybe", "-o", self.path("o.exr")),
+                     (ROOM, "--attrib", "mcrecon:filter", "box", "--attrib", "mcrecon:accumulate", "maybe",
+                      "-o:fileformatname=mcrecon", self.path("o2.exr"))):
+            with self.subTest(args=args[0]):
+                proc = oiiotool(*args, timeout=60)
+                self.assertNotEqual(proc.returncode, 0)
+                self.assertIn("accumulate expects 0, 1, true or false, got 'maybe'", proc.stdout + proc.stderr)
+                self.assertFalse(os.path.exists(args[-1]))
+
+
+class TestNotes(PluginTestBase):
+    def test_unused_setting_is_the_mcrecon_notes_attribute(self):
+        cli = tu.run_cli("denoise", ROOM, "-o", self.path("cli.exr"), "-f", "box", "--set", "firefly_radius=5",
+                         "--verbose")
+        notes = [l[len("mcrecon: note: "):] for l in cli.stderr.splitlines() if l.startswith("mcrecon: note: ")]
+        self.assertEqual(notes, ["firefly_radius has no effect with firefly_k=0"], cli.stderr)
+        name = ROOM + ".mcrecon?filter=box&firefly_radius=5"
+        # 1. the input plugin's spec, before any pixel is read
+        oiio.attribute("plugin_searchpath", plugin_dir())
+        inp = oiio.ImageInput.open(name)
+        self.assertIsNotNone(inp, oiio.geterror())
+        try:
+            self.assertEqual(inp.spec().getattribute("mcreconNotes"), notes[0])
+        finally:
+            inp.close()
+        # 2. a file written from the input plugin's read carries it
+        read = self.path("read.exr")
+        check_ok(oiiotool(name, "-o", read))
+        self.assertEqual(header_attribute(read, "mcreconNotes"), notes[0])
+        # 3. the output plugin's file
+        out = self.path("out.exr")
+        check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "--attrib:type=int", "mcrecon:firefly_radius",
+                          "5", "-o:fileformatname=mcrecon", out))
+        self.assertEqual(header_attribute(out, "mcreconNotes"), notes[0])
+        # Without the setting there is nothing to say.
+        quiet = self.path("quiet.exr")
+        check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "-o:fileformatname=mcrecon", quiet))
+        self.assertIsNone(header_attribute(quiet, "mcreconNotes"))
 
 
 class TestErrors(PluginTestBase):
