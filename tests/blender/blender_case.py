@@ -161,7 +161,8 @@ def check_passes():
     assert not any(r["filters"]["box"]["toggles"].values()), "box needs no feature pass"
     if "bilateral" in r["filters"]:
         t = r["filters"]["bilateral"]["toggles"]
-        assert t["use_pass_normal"] and t["use_pass_position"] and t["use_pass_z"] \
+        # bilateral's defaults: use_depth=off, so no depth pass (needs() drops it).
+        assert t["use_pass_normal"] and t["use_pass_position"] and not t["use_pass_z"] \
             and t["cycles.denoising_store_passes"] and not t["use_pass_vector"], t
     assert not any(r["after_operator_box"].values())
     for name, drawn in r["panel"].items():
