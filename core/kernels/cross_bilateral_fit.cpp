@@ -37,13 +37,29 @@ ParamTable cross_bilateral_fit_params() {
   return with_foveation(t, fov);
 }
 
+namespace {
+
+// The window half width for a spatial sigma: the fixed `radius` when given, else 3 sigma.
+int window_radius(int fixed, double sigma) { return sigma > 0 ? (fixed > 0 ? fixed : gaussian_radius(sigma)) : 0; }
+
+}  // namespace
+
+int cross_bilateral_fit_reach(const ParamSet& params) {
+  const int fixed = int(params.get_int("radius"));
+  int r = window_radius(fixed, params.get_float("spatial_sigma"));
+  if (params.get_bool("foveated")) r = std::max(r, window_radius(fixed, params.get_float("spatial_sigma_outer")));
+  if (params.get_int("order") == 1) r *= 2;
+  if (params.get_enum("colour_weight") == "noise") r += 3;
+  return r;
+}
+
 void cross_bilateral_fit(const Frame& frame, const Image& colour, const ParamSet& params, const std::string& owner,
                          const Roi& roi, Image& out, int nthreads, const std::function<void(std::string)>& note,
                          CrossBilateralScratch& s) {
   const int w = frame.width, h = frame.height;
   const Foveation fov(params, w, h);
   const int fixed = int(params.get_int("radius"));
-  auto radius_at = [&](double sigma) { return sigma > 0 ? (fixed > 0 ? fixed : gaussian_radius(sigma)) : 0; };
+  auto radius_at = [&](double sigma) { return window_radius(fixed, sigma); };
 
   const FoveatedValue spatial = fov.param("spatial_sigma");
   int rmax = 0, rmin = 1 << 30;

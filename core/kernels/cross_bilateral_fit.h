@@ -32,6 +32,12 @@ struct CrossBilateralScratch {
   std::vector<float> noise_a;  // colour_weight=noise: per-pixel sqrt(k) of the colour weight
 };
 
+// How far around the roi the kernel may read the colour (and the albedo of its weights), an
+// upper bound:
+// the window (twice for order=1: its colour weight is taken on the order-0 result of the
+// window), plus 3 px for the noise-relative colour weight's variance estimate.
+int cross_bilateral_fit_reach(const ParamSet& params);
+
 // Writes out inside roi; `params` holds cross_bilateral_fit_params() (and may hold more),
 // `owner` names the filter in errors; note() receives dropped-weight notes.
 void cross_bilateral_fit(const Frame& frame, const Image& colour, const ParamSet& params, const std::string& owner,

@@ -39,6 +39,7 @@ std::unique_ptr<Filter> with_every_step(const std::string& name) {
   if (p.has("holes")) f->set("holes", std::string("sample_count"));
   if (p.has("firefly_k")) f->set("firefly_k", 2.0);
   if (p.has("clamp")) f->set("clamp", 20.0);
+  if (p.has("colour_weight")) f->set("colour_weight", std::string("noise"));  // reads farther
   f->commit();
   return f;
 }

@@ -29,6 +29,10 @@ const FilterInfo& BilateralFilter::static_info() {
 
 void BilateralFilter::check_params() { check_foveation_params(params_, info().name); }
 
+Roi BilateralFilter::reads(const Roi& roi, int width, int height) const {
+  return roi.grown(cross_bilateral_fit_reach(params_), width, height);
+}
+
 std::vector<std::string> BilateralFilter::own_unused() const {
   std::vector<std::string> u = Filter::own_unused();
   unused_when(params_.get_int("order") == 0, "ridge", "with order=0", u);

@@ -14,6 +14,7 @@ class BilateralFilter : public Filter {
  protected:
   void check_params() override;
   std::vector<std::string> own_unused() const override;
+  Roi reads(const Roi& roi, int width, int height) const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:
