@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "expect_error.h"
 #include "io/atomic_write.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
@@ -25,6 +26,8 @@ namespace {
 
 namespace fs = std::filesystem;
 using Names = std::vector<std::string>;
+using testutil::contains;
+using testutil::expect_error;
 
 // A fresh directory per test, removed afterwards.
 class FrameIoTest : public testing::Test {
@@ -110,23 +113,6 @@ float written(const Names& channels, const std::string& name, int x, int y) {
   EXPECT_NE(it, channels.end()) << name;
   return value_of(x, y, int(it - channels.begin()));
 }
-
-template <class Fn>
-std::string expect_error(Errc code, Fn&& fn) {
-  try {
-    fn();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << "got " << errc_name(e.code()) << ": " << e.what();
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", got: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", nothing thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 // ---------------------------------------------------------------- reading
 
