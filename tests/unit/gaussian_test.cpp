@@ -254,15 +254,10 @@ TEST(GaussianFilterTest, FoveatedPathOnEveryInstructionSet) {
   GaussianFilter f;
   for (const auto& [k, v] : p) f.set(k, v);
   const Foveation fov(f.params(), 37, 29);
-  int ran = 0;
-  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
-    if (int(level) > int(best_isa())) continue;
-    const ScopedIsa use(level);
-    SCOPED_TRACE(isa_name(level));
+  const int ran = testutil::for_each_isa([&](Isa) {
     expect_brute(in, run_on(frame_of(in), p).out, [&](int x, int y) { return fov.value("sigma", fov.blend_at(x, y)); },
                  1e-4);
-    ++ran;
-  }
+  });
   EXPECT_GE(ran, 1);
 }
 
