@@ -14,6 +14,7 @@
 #include <string>
 #include <vector>
 
+#include "blender_channels_testutil.h"
 #include "expect_error.h"
 #include "io/atomic_write.h"
 #include "io/frame_reader.h"
@@ -26,6 +27,7 @@ namespace {
 
 namespace fs = std::filesystem;
 using Names = std::vector<std::string>;
+using testutil::blender_layer;
 using testutil::contains;
 using testutil::expect_error;
 
@@ -88,17 +90,6 @@ std::map<std::string, std::vector<float>> read_all(const std::string& path, int*
   if (w) *w = spec.width;
   if (h) *h = spec.height;
   return out;
-}
-
-Names blender_layer(const std::string& layer) {
-  const std::string p = layer + ".";
-  return {p + "Combined.R", p + "Combined.G", p + "Combined.B", p + "Combined.A",
-          p + "Denoising Albedo.R", p + "Denoising Albedo.G", p + "Denoising Albedo.B",
-          p + "Normal.X", p + "Normal.Y", p + "Normal.Z",
-          p + "Position.X", p + "Position.Y", p + "Position.Z", p + "Depth.Z",
-          p + "Vector.X", p + "Vector.Y", p + "Vector.Z", p + "Vector.W",
-          p + "Denoising Normal.X", p + "Denoising Normal.Y", p + "Denoising Normal.Z",
-          p + "Denoising Depth.Z"};
 }
 
 Names concat(std::initializer_list<Names> lists) {
