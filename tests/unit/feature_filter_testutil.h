@@ -238,18 +238,39 @@ inline void expect_same_for_one_and_two_threads(const RunFn& run, const Frame& f
   }
 }
 
-// With a region: the whole-frame result inside, the input colour outside.
-inline void expect_region_changes_only_inside(const RunFn& run, const Frame& f, Roi roi, const Params& p) {
-  const Image part = run(f, p, 0, roi).out;
-  const Image full = run(f, p, 0, {}).out;
-  const Image& in = f.image(Role::Colour);
-  for (int y = 0; y < f.height; ++y)
-    for (int x = 0; x < f.width; ++x)
+// The result of a run with a region (part): the whole-frame result inside, the input outside.
+inline void expect_only_region_changed(const Image& part, const Image& full, const Image& in, Roi roi) {
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x)
       for (int c = 0; c < 3; ++c) {
         const bool inside = x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1;
         ASSERT_EQ(part.at(x, y, c), inside ? full.at(x, y, c) : in.at(x, y, c)) << x << "," << y;
       }
+}
+
+// With a region: the whole-frame result inside, the input colour outside.
+inline void expect_region_changes_only_inside(const RunFn& run, const Frame& f, Roi roi, const Params& p) {
+  const Image full = run(f, p, 0, {}).out;
+  const Image& in = f.image(Role::Colour);
+  ASSERT_NO_FATAL_FAILURE(expect_only_region_changed(run(f, p, 0, roi).out, full, in, roi));
   EXPECT_GT(changed(full, in), 0.5);
+}
+
+// out has in's size and 3 channels, and each value lies within rel * max(1, |want|) of
+// want(x, y, double[3]), the oracle's pixel; what(x, y), a testing::Message, names the setting.
+template <class Want, class What>
+void expect_each_pixel_near(const Image& in, const Image& out, Want&& want, double rel, What&& what) {
+  ASSERT_EQ(out.width(), in.width());
+  ASSERT_EQ(out.height(), in.height());
+  ASSERT_EQ(out.channels(), 3);
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x) {
+      double w[3];
+      want(x, y, w);
+      for (int c = 0; c < 3; ++c)
+        ASSERT_NEAR(out.at(x, y, c), w[c], rel * std::max(1.0, std::fabs(w[c])))
+            << "pixel " << x << "," << y << " channel " << c << what(x, y);
+    }
 }
 
 // Runs body once per instruction set this CPU has (generic, AVX2, AVX-512), that set in
