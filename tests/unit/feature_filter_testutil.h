@@ -44,13 +44,15 @@ inline Image random_image(int w, int h, int ch, unsigned seed, float lo = 0.0f, 
   return im;
 }
 
-inline void add_pass(Frame& f, Role role, Image im) {
+inline Pass named_pass(Role role, std::string name, Image im) {
   Pass p;
   p.role = role;
-  p.name = role_name(role);
+  p.name = std::move(name);
   p.image = std::move(im);
-  f.passes.push_back(std::move(p));
+  return p;
 }
+
+inline void add_pass(Frame& f, Role role, Image im) { f.passes.push_back(named_pass(role, role_name(role), std::move(im))); }
 
 inline Frame colour_frame(const Image& colour) {
   Frame f;
@@ -82,8 +84,10 @@ struct Result {
   std::vector<std::string> notes;
 };
 
-// Sets the parameters on a fresh filter object, commits and runs it once.
-inline Result run_filter(Filter& f, const Frame& frame, const Params& params, int nthreads = 0, Roi roi = {}) {
+// Sets the parameters (name, value pairs in any container) on a fresh filter object,
+// commits and runs it once.
+template <class ParamList>
+Result run_filter(Filter& f, const Frame& frame, const ParamList& params, int nthreads = 0, Roi roi = {}) {
   for (const auto& [k, v] : params) f.set(k, v);
   f.commit();
   ExecOptions eo;

@@ -29,6 +29,7 @@ namespace {
 
 using testutil::kInf;
 using testutil::kNaN;
+using testutil::named_pass;
 using testutil::Params;
 using testutil::random_image;
 
@@ -39,24 +40,16 @@ struct Passes {
   Image colour, normal, depth, albedo, position;
 };
 
-Pass make_pass(Role role, const char* name, const Image& img) {
-  Pass p;
-  p.role = role;
-  p.name = name;
-  p.image = img;
-  return p;
-}
-
 Frame frame_of(const Passes& ps) {
   Frame f;
   f.width = ps.colour.width();
   f.height = ps.colour.height();
   f.path = "test.exr";
-  f.passes.push_back(make_pass(Role::Colour, "Combined", ps.colour));
-  if (!ps.normal.empty()) f.passes.push_back(make_pass(Role::Normal, "Normal", ps.normal));
-  if (!ps.depth.empty()) f.passes.push_back(make_pass(Role::Depth, "Depth", ps.depth));
-  if (!ps.albedo.empty()) f.passes.push_back(make_pass(Role::Albedo, "Albedo", ps.albedo));
-  if (!ps.position.empty()) f.passes.push_back(make_pass(Role::Position, "Position", ps.position));
+  f.passes.push_back(named_pass(Role::Colour, "Combined", ps.colour));
+  if (!ps.normal.empty()) f.passes.push_back(named_pass(Role::Normal, "Normal", ps.normal));
+  if (!ps.depth.empty()) f.passes.push_back(named_pass(Role::Depth, "Depth", ps.depth));
+  if (!ps.albedo.empty()) f.passes.push_back(named_pass(Role::Albedo, "Albedo", ps.albedo));
+  if (!ps.position.empty()) f.passes.push_back(named_pass(Role::Position, "Position", ps.position));
   return f;
 }
 
