@@ -25,12 +25,7 @@ Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi ro
   return run_filter<AtrousFilter>(frame, params, nthreads, roi);
 }
 
-// Sigmas wide enough that random features still let neighbours mix (the
-// defaults make random data close to the identity, which would prove little).
-Params mild() {
-  return {{"iterations", std::int64_t(3)}, {"colour_sigma", 0.8}, {"normal_sigma", 1.0}, {"position_sigma", 1.5},
-          {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
-}
+Params mild() { return with(mild_features(), {{"iterations", std::int64_t(3)}}); }
 
 std::vector<double> kernel_1d(int kg) {
   if (kg == 3) return {1 / 4.0, 2 / 4.0, 1 / 4.0};

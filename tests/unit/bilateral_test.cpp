@@ -28,12 +28,7 @@ Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi ro
   return run_filter<BilateralFilter>(frame, params, nthreads, roi);
 }
 
-// Sigmas wide enough that random features still let neighbours mix (the
-// defaults make random data close to the identity, which would prove little).
-Params mild() {
-  return {{"spatial_sigma", 1.5}, {"colour_sigma", 0.8}, {"normal_sigma", 1.0}, {"position_sigma", 1.5},
-          {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
-}
+Params mild() { return with(mild_features(), {{"spatial_sigma", 1.5}}); }
 
 TEST(BilateralFilterTest, FastExpIsAccurate) {
   EXPECT_EQ(fast_exp_neg(0.0f), 1.0f);

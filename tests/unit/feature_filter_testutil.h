@@ -135,6 +135,13 @@ inline Params with(Params p, const Params& more) {
   return p;
 }
 
+// Feature sigmas wide enough that random features still let neighbours mix (the
+// defaults make random data close to the identity, which would prove little), depth on.
+inline Params mild_features() {
+  return {{"colour_sigma", 0.8}, {"normal_sigma", 1.0}, {"position_sigma", 1.5},
+          {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
+}
+
 // ---------------------------------------------------------------------------
 // Checks shared by the feature filters. RunFn is the test's run_on (frame, parameters,
 // thread count, region); RefFn its oracle (frame, parameters).
