@@ -25,24 +25,7 @@ Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi ro
   return run_filter<AtrousFilter>(frame, params, nthreads, roi);
 }
 
-// Sigmas wide enough that random features still let neighbours mix (the
-// defaults make random data close to the identity, which would prove little).
-Params mild() {
-  return {{"iterations", std::int64_t(3)}, {"colour_sigma", 0.8}, {"normal_sigma", 1.0}, {"position_sigma", 1.5},
-          {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
-}
-
-double changed(const Image& out, const Image& in) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < out.storage().size(); ++i) n += std::fabs(out.storage()[i] - in.storage()[i]) > 1e-3f;
-  return double(n) / double(out.storage().size());
-}
-
-bool finite_n(const float* p, int n) {
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(p[i])) return false;
-  return true;
-}
+Params mild() { return with(mild_features(), {{"iterations", std::int64_t(3)}}); }
 
 std::vector<double> kernel_1d(int kg) {
   if (kg == 3) return {1 / 4.0, 2 / 4.0, 1 / 4.0};
@@ -125,16 +108,6 @@ Image reference(const Frame& frame, const Params& given) {
   return out;
 }
 
-void expect_close(const Image& got, const Image& want, double rel, const char* what = "") {
-  ASSERT_EQ(got.width(), want.width());
-  ASSERT_EQ(got.height(), want.height());
-  for (int y = 0; y < got.height(); ++y)
-    for (int x = 0; x < got.width(); ++x)
-      for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(got.at(x, y, c), want.at(x, y, c), rel * std::max(1.0f, std::fabs(want.at(x, y, c))))
-            << what << " pixel " << x << "," << y << " channel " << c;
-}
-
 TEST(AtrousFilterTest, GeneratingKernels) {
   for (int kg : {3, 5, 9}) {
     const std::vector<float> h = AtrousFilter::generating_kernel(kg);
@@ -211,29 +184,12 @@ TEST(AtrousFilterTest, TinyFeatureSigmaIsIdentity) {
 }
 
 TEST(AtrousFilterTest, NormalEdgeIsPreserved) {
-  const int w = 40, h = 24;
-  Image colour = random_image(w, h, 3, 6, -0.05f, 0.05f);
-  Image normal(w, h, 3, 0.0f);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const bool left = x < w / 2;
-      for (int c = 0; c < 3; ++c) colour.at(x, y, c) += left ? 0.2f : 0.8f;
-      normal.at(x, y, left ? 2 : 0) = 1.0f;
-    }
-  Frame f = colour_frame(colour);
-  add_pass(f, Role::Normal, normal);
+  const TwoSided s = two_sided(40, 24);
+  Frame f = colour_frame(s.colour);
+  add_pass(f, Role::Normal, s.normal);
   const Image out = run_on(f, with(all_off(), {{"use_normal", std::string("on")}, {"normal_sigma", 0.1},
                                                {"iterations", std::int64_t(4)}})).out;
-  double var_in = 0, var_out = 0;
-  for (int y = 0; y < h; ++y) {
-    EXPECT_NEAR(out.at(w / 2 - 1, y, 0), 0.2f, 0.03f) << y;
-    EXPECT_NEAR(out.at(w / 2, y, 2), 0.8f, 0.03f) << y;
-    for (int x = 2; x < 12; ++x) {
-      var_in += std::pow(colour.at(x, y, 0) - 0.2, 2);
-      var_out += std::pow(out.at(x, y, 0) - 0.2, 2);
-    }
-  }
-  EXPECT_LT(var_out, 0.1 * var_in);
+  expect_edge_kept_and_flat_smoothed(out, s.colour, 2, 12);
 }
 
 TEST(AtrousFilterTest, ColourWeightStopsFireflies) {
@@ -245,15 +201,7 @@ TEST(AtrousFilterTest, ColourWeightStopsFireflies) {
 }
 
 TEST(AtrousFilterTest, ConstantImageAndEqualFeatures) {
-  for (float v : {0.0f, 0.375f, -2.5f, 1e-30f, 1e30f, 3.3e38f, FLT_MAX}) {
-    Frame f = colour_frame(Image(13, 9, 3, v));
-    add_pass(f, Role::Normal, Image(13, 9, 3, 0.5f));
-    add_pass(f, Role::Position, Image(13, 9, 3, v));
-    add_pass(f, Role::Albedo, Image(13, 9, 3, 0.0f));
-    Result r = run_on(f, {{"iterations", std::int64_t(3)}});
-    EXPECT_EQ(r.repaired, 0u);
-    for (float o : r.out.storage()) ASSERT_NEAR(o, v, 1e-6 * std::fabs(v)) << "constant " << v;
-  }
+  expect_constant_stays_constant(run_on, {{"iterations", std::int64_t(3)}});
 }
 
 TEST(AtrousFilterTest, ParameterLimits) {
@@ -281,33 +229,14 @@ TEST(AtrousFilterTest, ParameterLimits) {
 }
 
 TEST(AtrousFilterTest, DegenerateShapes) {
-  for (auto [w, h] : {std::pair{1, 1}, std::pair{1, 9}, std::pair{9, 1}, std::pair{2, 1}, std::pair{1, 2},
-                      std::pair{19, 2}}) {
-    SCOPED_TRACE(testing::Message() << w << "x" << h);
-    const Frame f = full_frame(w, h, unsigned(w * 31 + h));
-    expect_close(run_on(f, mild()).out, reference(f, mild()), 1e-4);
-  }
+  expect_degenerate_shapes_match(run_on, reference, mild(), {19, 2});
 }
 
 TEST(AtrousFilterTest, TinyAndHugeValues) {
-  Image in(30, 20, 3, 1e-30f);
-  in.at(5, 5, 0) = 1e30f;
-  in.at(5, 5, 1) = -1e30f;
-  Frame f = colour_frame(in);
-  add_pass(f, Role::Normal, random_image(30, 20, 3, 8));
-  add_pass(f, Role::Position, Image(30, 20, 3, 1e30f));
-  for (const Params& p : {Params{{"iterations", std::int64_t(3)}, {"normal_sigma", 1.0}},
-                          with(all_off(), {{"iterations", std::int64_t(3)}})}) {
-    Result r = run_on(f, p);
-    EXPECT_EQ(r.repaired, 0u);
-    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
-    expect_close(r.out, reference(f, p), 1e-4);
-  }
-  Image big(12, 12, 3, FLT_MAX);
-  big.at(2, 2, 2) = -FLT_MAX;
-  Result b = run_on(colour_frame(big), with(all_off(), {{"iterations", std::int64_t(4)}}));
-  EXPECT_EQ(b.repaired, 0u);
-  for (float v : b.out.storage()) ASSERT_TRUE(std::isfinite(v));
+  expect_tiny_and_huge_values_handled(
+      run_on, reference,
+      {Params{{"iterations", std::int64_t(3)}, {"normal_sigma", 1.0}}, with(all_off(), {{"iterations", std::int64_t(3)}})},
+      with(all_off(), {{"iterations", std::int64_t(4)}}));
 }
 
 TEST(AtrousFilterTest, NonFiniteColourAndFeaturesFollowThePolicy) {
@@ -317,34 +246,20 @@ TEST(AtrousFilterTest, NonFiniteColourAndFeaturesFollowThePolicy) {
   for (Role role : kFeatureRoles) {
     SCOPED_TRACE(role_name(role));
     Frame f = full_frame(19, 15, 9);
-    Image& im = pass_image(f, role);
-    im.at(4, 4, 0) = kNaN;
-    im.at(10, 7, std::min(1, im.channels() - 1)) = kInf;
-    im.at(18, 14, 0) = -kInf;
-    for (int y = 0; y < 4; ++y)  // a blob wider than the first pass' reach
-      for (int x = 11; x < 18; ++x) im.at(x, y, 0) = kNaN;
+    poison(pass_image(f, role), Roi{11, 0, 18, 4});  // a blob wider than the first pass' reach
     Result r = run_on(f, p);
-    EXPECT_EQ(r.repaired, 0u);
-    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+    ASSERT_NO_FATAL_FAILURE(expect_finite_unrepaired(r));
     expect_close(r.out, reference(f, p), 1e-4);
   }
 }
 
 TEST(AtrousFilterTest, ZeroAlbedoWithDemodulation) {
-  Frame f = full_frame(16, 12, 10);
-  Image& a = pass_image(f, Role::Albedo);
-  for (float& v : a.storage()) v = 0.0f;
-  Result r = run_on(f, {{"demodulate", true}});
-  EXPECT_EQ(r.repaired, 0u);
-  for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+  expect_finite_unrepaired(run_on(zero_albedo_frame(), {{"demodulate", true}}));
 }
 
 TEST(AtrousFilterTest, AbsentFeaturesAreDroppedWithANoteOrRequired) {
   const Frame f = colour_frame(random_image(10, 8, 3, 7));
-  Result r = run_on(f, {});
-  bool note = false;
-  for (const std::string& n : r.notes) note = note || n.find("normal weight dropped") != std::string::npos;
-  EXPECT_TRUE(note);
+  EXPECT_TRUE(has_note(run_on(f, {}), "normal weight dropped"));
   EXPECT_THROW(run_on(f, {{"use_position", std::string("on")}}), Error);
 }
 
@@ -352,30 +267,16 @@ TEST(AtrousFilterTest, IdenticalForOneAndTwoThreads) {
   Frame f = full_frame(70, 45, 11);
   pass_image(f, Role::Position).at(5, 5, 1) = kNaN;
   pass_image(f, Role::Colour).at(50, 20, 0) = kInf;
-  for (const Params& p : {with(mild(), {{"iterations", std::int64_t(4)}}),
-                          with(mild(), {{"foveated", true}, {"colour_sigma", 0.1}, {"colour_sigma_outer", 2.0},
-                                        {"normal_sigma_outer", 3.0}, {"inner_radius", 0.05}})}) {
-    const Image one = run_on(f, p, 1).out;
-    const Image two = run_on(f, p, 2).out;
-    EXPECT_EQ(one.storage(), two.storage());
-    EXPECT_GT(changed(one, f.image(Role::Colour)), 0.3);
-  }
+  expect_same_for_one_and_two_threads(
+      run_on, f,
+      {with(mild(), {{"iterations", std::int64_t(4)}}),
+       with(mild(), {{"foveated", true}, {"colour_sigma", 0.1}, {"colour_sigma_outer", 2.0},
+                     {"normal_sigma_outer", 3.0}, {"inner_radius", 0.05}})});
 }
 
 TEST(AtrousFilterTest, RegionChangesOnlyPixelsInside) {
-  const Frame f = full_frame(50, 36, 12);
-  const Roi roi{13, 9, 31, 20};
-  const Params p = with(mild(), {{"iterations", std::int64_t(4)}, {"kernel_size", std::int64_t(5)}});
-  const Image part = run_on(f, p, 0, roi).out;
-  const Image full = run_on(f, p).out;
-  const Image& in = f.image(Role::Colour);
-  for (int y = 0; y < f.height; ++y)
-    for (int x = 0; x < f.width; ++x)
-      for (int c = 0; c < 3; ++c) {
-        const bool inside = x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1;
-        ASSERT_EQ(part.at(x, y, c), inside ? full.at(x, y, c) : in.at(x, y, c)) << x << "," << y;
-      }
-  EXPECT_GT(changed(full, in), 0.5);
+  expect_region_changes_only_inside(run_on, full_frame(50, 36, 12), Roi{13, 9, 31, 20},
+                                    with(mild(), {{"iterations", std::int64_t(4)}, {"kernel_size", std::int64_t(5)}}));
 }
 
 TEST(AtrousFilterTest, EveryInstructionSetMatchesTheReference) {
@@ -384,15 +285,10 @@ TEST(AtrousFilterTest, EveryInstructionSetMatchesTheReference) {
   pass_image(f, Role::Colour).at(40, 3, 2) = -kInf;
   const Params p = {{"iterations", std::int64_t(3)}, {"use_depth", std::string("on")}, {"normal_sigma", 0.9},
                     {"position_sigma", 1.2}, {"albedo_sigma", 0.6}};
-  int ran = 0;
-  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
-    if (int(level) > int(best_isa())) continue;
-    const ScopedIsa use(level);
-    SCOPED_TRACE(isa_name(level));
+  const int ran = for_each_isa([&](Isa) {
     expect_close(run_on(f, p).out, reference(f, p), 1e-4);
     EXPECT_EQ(run_on(f, p, 1).out.storage(), run_on(f, p, 2).out.storage());
-    ++ran;
-  }
+  });
   EXPECT_GE(ran, 1);
 }
 

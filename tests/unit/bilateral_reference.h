@@ -12,12 +12,6 @@
 
 namespace mcr::testutil {
 
-inline bool finite_n(const float* p, int n) {
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(p[i])) return false;
-  return true;
-}
-
 inline Image bilateral_reference(const Frame& frame, const Params& given) {
   BilateralFilter probe;
   for (const auto& [k, v] : given) probe.set(k, v);

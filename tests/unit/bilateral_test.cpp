@@ -28,29 +28,7 @@ Result run_on(const Frame& frame, const Params& params, int nthreads = 0, Roi ro
   return run_filter<BilateralFilter>(frame, params, nthreads, roi);
 }
 
-// Sigmas wide enough that random features still let neighbours mix (the
-// defaults make random data close to the identity, which would prove little).
-Params mild() {
-  return {{"spatial_sigma", 1.5}, {"colour_sigma", 0.8}, {"normal_sigma", 1.0}, {"position_sigma", 1.5},
-          {"albedo_sigma", 0.8}, {"use_depth", std::string("on")}, {"depth_sigma", 1.0}};
-}
-
-// Fraction of values that moved by more than 1e-3: the filter did something.
-double changed(const Image& out, const Image& in) {
-  std::size_t n = 0;
-  for (std::size_t i = 0; i < out.storage().size(); ++i) n += std::fabs(out.storage()[i] - in.storage()[i]) > 1e-3f;
-  return double(n) / double(out.storage().size());
-}
-
-void expect_close(const Image& got, const Image& want, double rel, const char* what = "") {
-  ASSERT_EQ(got.width(), want.width());
-  ASSERT_EQ(got.height(), want.height());
-  for (int y = 0; y < got.height(); ++y)
-    for (int x = 0; x < got.width(); ++x)
-      for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(got.at(x, y, c), want.at(x, y, c), rel * std::max(1.0f, std::fabs(want.at(x, y, c))))
-            << what << " pixel " << x << "," << y << " channel " << c;
-}
+Params mild() { return with(mild_features(), {{"spatial_sigma", 1.5}}); }
 
 TEST(BilateralFilterTest, FastExpIsAccurate) {
   EXPECT_EQ(fast_exp_neg(0.0f), 1.0f);
@@ -133,34 +111,15 @@ TEST(BilateralFilterTest, SpatialSigmaLimits) {
 // Left half faces +z, right half +x; colours differ across the edge. With the
 // normal weight only, pixels next to the edge average their own side only.
 TEST(BilateralFilterTest, NormalAndPositionEdgesArePreserved) {
-  const int w = 32, h = 24;
-  Image colour = random_image(w, h, 3, 6, -0.05f, 0.05f);
-  Image normal(w, h, 3, 0.0f), position(w, h, 3, 0.0f);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const bool left = x < w / 2;
-      for (int c = 0; c < 3; ++c) colour.at(x, y, c) += left ? 0.2f : 0.8f;
-      normal.at(x, y, left ? 2 : 0) = 1.0f;
-      position.at(x, y, 2) = left ? 0.0f : 5.0f;  // a depth step
-    }
+  const TwoSided s = two_sided(32, 24);
   for (Role guide : {Role::Normal, Role::Position}) {
-    Frame f = colour_frame(colour);
-    add_pass(f, guide, guide == Role::Normal ? normal : position);
+    Frame f = colour_frame(s.colour);
+    add_pass(f, guide, guide == Role::Normal ? s.normal : s.position);
     const Params p = with(all_off(), {{"spatial_sigma", 3.0},
                                       {guide == Role::Normal ? "use_normal" : "use_position", std::string("on")},
                                       {"normal_sigma", 0.1},
                                       {"position_sigma", 0.1}});
-    const Image out = run_on(f, p).out;
-    double var_in = 0, var_out = 0;
-    for (int y = 0; y < h; ++y) {
-      EXPECT_NEAR(out.at(w / 2 - 1, y, 0), 0.2f, 0.03f) << "left of the edge, row " << y;
-      EXPECT_NEAR(out.at(w / 2, y, 1), 0.8f, 0.03f) << "right of the edge, row " << y;
-      for (int x = 2; x < 10; ++x) {
-        var_in += std::pow(colour.at(x, y, 0) - 0.2, 2);
-        var_out += std::pow(out.at(x, y, 0) - 0.2, 2);
-      }
-    }
-    EXPECT_LT(var_out, 0.1 * var_in) << "flat regions are smoothed";
+    expect_edge_kept_and_flat_smoothed(run_on(f, p).out, s.colour, 1, 10);
   }
 }
 
@@ -178,13 +137,8 @@ TEST(BilateralFilterTest, ColourWeightStopsFireflies) {
 TEST(BilateralFilterTest, AbsentFeaturesAreDroppedWithANoteOrRequired) {
   const Frame f = colour_frame(random_image(10, 8, 3, 7));
   Result r = run_on(f, {});
-  bool normal_note = false, position_note = false;
-  for (const std::string& n : r.notes) {
-    normal_note = normal_note || n.find("normal weight dropped") != std::string::npos;
-    position_note = position_note || n.find("position weight dropped") != std::string::npos;
-  }
-  EXPECT_TRUE(normal_note);
-  EXPECT_TRUE(position_note);
+  EXPECT_TRUE(has_note(r, "normal weight dropped"));
+  EXPECT_TRUE(has_note(r, "position weight dropped"));
   expect_close(r.out, bilateral_reference(f, {}), 1e-4);
   try {
     run_on(f, {{"use_normal", std::string("on")}});
@@ -198,44 +152,18 @@ TEST(BilateralFilterTest, AbsentFeaturesAreDroppedWithANoteOrRequired) {
 }
 
 TEST(BilateralFilterTest, ConstantImageAndEqualFeatures) {
-  for (float v : {0.0f, 0.375f, -2.5f, 1e-30f, 1e30f, 3.3e38f, FLT_MAX}) {
-    Frame f = colour_frame(Image(13, 9, 3, v));
-    add_pass(f, Role::Normal, Image(13, 9, 3, 0.5f));
-    add_pass(f, Role::Position, Image(13, 9, 3, v));  // all-equal features, even huge
-    add_pass(f, Role::Albedo, Image(13, 9, 3, 0.0f));
-    Result r = run_on(f, {{"spatial_sigma", 2.0}});
-    EXPECT_EQ(r.repaired, 0u);
-    for (float o : r.out.storage()) ASSERT_NEAR(o, v, 1e-6 * std::fabs(v)) << "constant " << v;
-  }
+  expect_constant_stays_constant(run_on, {{"spatial_sigma", 2.0}});
 }
 
 TEST(BilateralFilterTest, DegenerateShapes) {
-  for (auto [w, h] : {std::pair{1, 1}, std::pair{1, 9}, std::pair{9, 1}, std::pair{2, 1}, std::pair{1, 2},
-                      std::pair{17, 3}}) {
-    SCOPED_TRACE(testing::Message() << w << "x" << h);
-    const Frame f = full_frame(w, h, unsigned(w * 31 + h));
-    expect_close(run_on(f, mild()).out, bilateral_reference(f, mild()), 1e-4);
-  }
+  expect_degenerate_shapes_match(run_on, bilateral_reference, mild(), {17, 3});
 }
 
 TEST(BilateralFilterTest, TinyAndHugeValues) {
-  Image in(30, 20, 3, 1e-30f);
-  in.at(5, 5, 0) = 1e30f;
-  in.at(5, 5, 1) = -1e30f;
-  Frame f = colour_frame(in);
-  add_pass(f, Role::Normal, random_image(30, 20, 3, 8));
-  add_pass(f, Role::Position, Image(30, 20, 3, 1e30f));
-  for (const Params& p : {with(mild(), {{"use_depth", std::string("off")}}), with(all_off(), {{"spatial_sigma", 1.5}})}) {
-    Result r = run_on(f, p);
-    EXPECT_EQ(r.repaired, 0u);
-    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
-    expect_close(r.out, bilateral_reference(f, p), 1e-4);
-  }
-  Image big(12, 12, 3, FLT_MAX);
-  big.at(2, 2, 2) = -FLT_MAX;
-  Result b = run_on(colour_frame(big), with(all_off(), {{"spatial_sigma", 3.0}}));
-  EXPECT_EQ(b.repaired, 0u);
-  for (float v : b.out.storage()) ASSERT_TRUE(std::isfinite(v));
+  expect_tiny_and_huge_values_handled(
+      run_on, bilateral_reference,
+      {with(mild(), {{"use_depth", std::string("off")}}), with(all_off(), {{"spatial_sigma", 1.5}})},
+      with(all_off(), {{"spatial_sigma", 3.0}}));
 }
 
 // NaN and Inf in the colour and in each feature: finite output, nothing
@@ -246,15 +174,9 @@ TEST(BilateralFilterTest, NonFiniteColourAndFeaturesFollowThePolicy) {
   for (Role role : kFeatureRoles) {
     SCOPED_TRACE(role_name(role));
     Frame f = full_frame(19, 15, 9);
-    Image& im = pass_image(f, role);
-    im.at(4, 4, 0) = kNaN;
-    im.at(10, 7, std::min(1, im.channels() - 1)) = kInf;
-    im.at(18, 14, 0) = -kInf;  // corner
-    for (int y = 0; y < 3; ++y)  // a blob: centres inside have no usable neighbour
-      for (int x = 12; x < 17; ++x) im.at(x, y, 0) = kNaN;
+    poison(pass_image(f, role), Roi{12, 0, 17, 3});  // a blob: centres inside have no usable neighbour
     Result r = run_on(f, p);
-    EXPECT_EQ(r.repaired, 0u);
-    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+    ASSERT_NO_FATAL_FAILURE(expect_finite_unrepaired(r));
     expect_close(r.out, bilateral_reference(f, p), 1e-4);
     // A 3x3 window inside the blob has no usable sample: the pixel keeps its colour (if finite).
     const Params narrow = with(p, {{"spatial_sigma", 0.3}});
@@ -271,42 +193,23 @@ TEST(BilateralFilterTest, NonFiniteColourAndFeaturesFollowThePolicy) {
 }
 
 TEST(BilateralFilterTest, ZeroAlbedoWithDemodulation) {
-  Frame f = full_frame(16, 12, 10);
-  Image& a = pass_image(f, Role::Albedo);
-  for (float& v : a.storage()) v = 0.0f;
-  a.at(3, 3, 0) = kNaN;
-  Result r = run_on(f, {{"demodulate", true}});
-  EXPECT_EQ(r.repaired, 0u);
-  for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+  Frame f = zero_albedo_frame();
+  pass_image(f, Role::Albedo).at(3, 3, 0) = kNaN;
+  expect_finite_unrepaired(run_on(f, {{"demodulate", true}}));
 }
 
 TEST(BilateralFilterTest, IdenticalForOneAndTwoThreads) {
   Frame f = full_frame(67, 41, 11);
   pass_image(f, Role::Normal).at(5, 5, 1) = kNaN;
   pass_image(f, Role::Colour).at(50, 20, 0) = kInf;
-  for (const Params& p : {mild(), with(mild(), {{"foveated", true}, {"spatial_sigma", 0.5}, {"spatial_sigma_outer", 3.0},
-                                               {"colour_sigma_outer", 2.0}, {"inner_radius", 0.05}})}) {
-    const Image one = run_on(f, p, 1).out;
-    const Image two = run_on(f, p, 2).out;
-    EXPECT_EQ(one.storage(), two.storage());
-    EXPECT_GT(changed(one, f.image(Role::Colour)), 0.3);
-  }
+  expect_same_for_one_and_two_threads(
+      run_on, f,
+      {mild(), with(mild(), {{"foveated", true}, {"spatial_sigma", 0.5}, {"spatial_sigma_outer", 3.0},
+                             {"colour_sigma_outer", 2.0}, {"inner_radius", 0.05}})});
 }
 
 TEST(BilateralFilterTest, RegionChangesOnlyPixelsInside) {
-  const Frame f = full_frame(30, 20, 12);
-  const Roi roi{7, 3, 19, 11};
-  const Params p = mild();
-  const Image part = run_on(f, p, 0, roi).out;
-  const Image full = run_on(f, p).out;
-  const Image& in = f.image(Role::Colour);
-  for (int y = 0; y < 20; ++y)
-    for (int x = 0; x < 30; ++x)
-      for (int c = 0; c < 3; ++c) {
-        const bool inside = x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1;
-        ASSERT_EQ(part.at(x, y, c), inside ? full.at(x, y, c) : in.at(x, y, c)) << x << "," << y;
-      }
-  EXPECT_GT(changed(full, in), 0.5);
+  expect_region_changes_only_inside(run_on, full_frame(30, 20, 12), Roi{7, 3, 19, 11}, mild());
 }
 
 // The kernel is built for several instruction sets; each must implement the same filter.
@@ -318,16 +221,11 @@ TEST(BilateralFilterTest, EveryInstructionSetMatchesTheReference) {
                     {"position_sigma", 1.2}, {"albedo_sigma", 0.6}};
   const Params fov = with(p, {{"foveated", true}, {"spatial_sigma", 0.6}, {"spatial_sigma_outer", 2.0},
                               {"colour_sigma_outer", 1.5}, {"inner_radius", 0.05}});
-  int ran = 0;
-  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
-    if (int(level) > int(best_isa())) continue;
-    const ScopedIsa use(level);
-    SCOPED_TRACE(isa_name(level));
+  const int ran = for_each_isa([&](Isa level) {
     EXPECT_EQ(isa(), level);
     expect_close(run_on(f, p).out, bilateral_reference(f, p), 1e-4);
     EXPECT_EQ(run_on(f, fov, 1).out.storage(), run_on(f, fov, 2).out.storage());
-    ++ran;
-  }
+  });
   EXPECT_GE(ran, 1);
   EXPECT_THROW(parse_isa("neon512", "MCRECON_ISA"), Error);
 }

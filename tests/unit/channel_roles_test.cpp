@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "blender_channels_testutil.h"
+
 namespace mcr {
 namespace {
 
@@ -61,13 +63,7 @@ TEST(ChannelRolesTest, BlenderMultilayerPassesWithAnyLayerName) {
   for (const std::string layer : {"ViewLayer", "RenderLayer", "Main Layer", "shot.v2"}) {
     SCOPED_TRACE(layer);
     const std::string p = layer + ".";
-    const Names ch = {p + "Combined.R", p + "Combined.G", p + "Combined.B", p + "Combined.A",
-                      p + "Denoising Albedo.R", p + "Denoising Albedo.G", p + "Denoising Albedo.B",
-                      p + "Normal.X", p + "Normal.Y", p + "Normal.Z",
-                      p + "Position.X", p + "Position.Y", p + "Position.Z", p + "Depth.Z",
-                      p + "Vector.X", p + "Vector.Y", p + "Vector.Z", p + "Vector.W",
-                      p + "Denoising Normal.X", p + "Denoising Normal.Y", p + "Denoising Normal.Z",
-                      p + "Denoising Depth.Z"};
+    const Names ch = testutil::blender_layer(layer);
     auto combined = roles_of(ch, p + "Combined");
     ASSERT_EQ(combined.size(), 2u);
     EXPECT_EQ(combined[0].first, Role::Colour);
@@ -75,29 +71,29 @@ TEST(ChannelRolesTest, BlenderMultilayerPassesWithAnyLayerName) {
     EXPECT_EQ(combined[1].first, Role::Alpha);
     EXPECT_EQ(combined[1].second, (Names{p + "Combined.A"}));
 
-    auto albedo = roles_of(ch, p + "Denoising Albedo");
-    ASSERT_EQ(albedo.size(), 1u);
-    EXPECT_EQ(albedo[0].first, Role::Albedo);
-    auto normal = roles_of(ch, p + "Normal");
-    ASSERT_EQ(normal.size(), 1u);
-    EXPECT_EQ(normal[0].first, Role::Normal);
-    EXPECT_EQ(normal[0].second, (Names{p + "Normal.X", p + "Normal.Y", p + "Normal.Z"}));
-    auto dn = roles_of(ch, p + "Denoising Normal");
-    ASSERT_EQ(dn.size(), 1u);
-    EXPECT_EQ(dn[0].first, Role::Normal);
-    auto pos = roles_of(ch, p + "Position");
-    ASSERT_EQ(pos.size(), 1u);
-    EXPECT_EQ(pos[0].first, Role::Position);
-    auto depth = roles_of(ch, p + "Depth");
-    ASSERT_EQ(depth.size(), 1u);
-    EXPECT_EQ(depth[0].first, Role::Depth);
-    auto dd = roles_of(ch, p + "Denoising Depth");
-    ASSERT_EQ(dd.size(), 1u);
-    EXPECT_EQ(dd[0].first, Role::Depth);
-    auto motion = roles_of(ch, p + "Vector");
-    ASSERT_EQ(motion.size(), 1u);
-    EXPECT_EQ(motion[0].first, Role::Motion);
-    EXPECT_EQ(motion[0].second, (Names{p + "Vector.X", p + "Vector.Y", p + "Vector.Z", p + "Vector.W"}));
+    // The passes with one role each; where suffixes are given, the channels it takes.
+    struct Single {
+      const char* pass;
+      Role role;
+      Names suffixes;  // empty: the channels are not checked
+    };
+    const Single singles[] = {
+        {"Denoising Albedo", Role::Albedo, {}}, {"Normal", Role::Normal, {"X", "Y", "Z"}},
+        {"Denoising Normal", Role::Normal, {}}, {"Position", Role::Position, {}},
+        {"Depth", Role::Depth, {}},             {"Denoising Depth", Role::Depth, {}},
+        {"Vector", Role::Motion, {"X", "Y", "Z", "W"}},
+    };
+    for (const Single& s : singles) {
+      SCOPED_TRACE(s.pass);
+      const std::string group = p + s.pass;
+      auto r = roles_of(ch, group);
+      ASSERT_EQ(r.size(), 1u);
+      EXPECT_EQ(r[0].first, s.role);
+      if (s.suffixes.empty()) continue;
+      Names want;
+      for (const std::string& suffix : s.suffixes) want.push_back(group + "." + suffix);
+      EXPECT_EQ(r[0].second, want);
+    }
   }
 }
 

@@ -8,13 +8,15 @@
 #include <map>
 #include <random>
 
+#include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
 
 namespace mcr {
 namespace {
 
-using Params = std::map<std::string, ParamValue>;
+using testutil::Params;
+using testutil::with;
 
 ParamTable demo_table() {
   return with_foveation({ParamSpec::Float("sigma", 1.5, 0.0, 10.0, "blur"), ParamSpec::Int("radius", 2, 0, 9, "r"),
@@ -126,30 +128,15 @@ TEST(FoveationTest, OuterRadiusBelowInnerIsRejected) {
 // ---------------------------------------------------------------------------
 // The filters.
 
-Image random_image(int w, int h, int ch, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> dist(lo, hi);
-  Image im(w, h, ch);
-  for (float& v : im.storage()) v = dist(rng);
-  return im;
-}
-
+// Colour, normal, position and albedo (no depth), random.
 Frame test_frame(int w, int h, unsigned seed) {
-  Frame f;
-  f.width = w;
-  f.height = h;
+  using testutil::add_pass;
+  using testutil::random_image;
+  Frame f = testutil::colour_frame(random_image(w, h, 3, seed));
   f.path = "fovea.exr";
-  auto add = [&](Role r, Image im) {
-    Pass p;
-    p.role = r;
-    p.name = role_name(r);
-    p.image = std::move(im);
-    f.passes.push_back(std::move(p));
-  };
-  add(Role::Colour, random_image(w, h, 3, seed));
-  add(Role::Normal, random_image(w, h, 3, seed + 1, -1.0f, 1.0f));
-  add(Role::Position, random_image(w, h, 3, seed + 2, 0.0f, 3.0f));
-  add(Role::Albedo, random_image(w, h, 3, seed + 3, 0.1f, 1.0f));
+  add_pass(f, Role::Normal, random_image(w, h, 3, seed + 1, -1.0f, 1.0f));
+  add_pass(f, Role::Position, random_image(w, h, 3, seed + 2, 0.0f, 3.0f));
+  add_pass(f, Role::Albedo, random_image(w, h, 3, seed + 3, 0.1f, 1.0f));
   return f;
 }
 
@@ -160,11 +147,6 @@ Image run(const std::string& filter, const Frame& frame, const Params& params, i
   ExecOptions eo;
   eo.nthreads = nthreads;
   return f->execute(frame, eo);
-}
-
-Params with(Params p, const Params& more) {
-  for (const auto& [k, v] : more) p[k] = v;
-  return p;
 }
 
 // Inner set, outer set and the parameters they differ in, per filter.

@@ -14,6 +14,8 @@
 #include <string>
 #include <vector>
 
+#include "blender_channels_testutil.h"
+#include "expect_error.h"
 #include "io/atomic_write.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
@@ -25,6 +27,9 @@ namespace {
 
 namespace fs = std::filesystem;
 using Names = std::vector<std::string>;
+using testutil::blender_layer;
+using testutil::contains;
+using testutil::expect_error;
 
 // A fresh directory per test, removed afterwards.
 class FrameIoTest : public testing::Test {
@@ -87,17 +92,6 @@ std::map<std::string, std::vector<float>> read_all(const std::string& path, int*
   return out;
 }
 
-Names blender_layer(const std::string& layer) {
-  const std::string p = layer + ".";
-  return {p + "Combined.R", p + "Combined.G", p + "Combined.B", p + "Combined.A",
-          p + "Denoising Albedo.R", p + "Denoising Albedo.G", p + "Denoising Albedo.B",
-          p + "Normal.X", p + "Normal.Y", p + "Normal.Z",
-          p + "Position.X", p + "Position.Y", p + "Position.Z", p + "Depth.Z",
-          p + "Vector.X", p + "Vector.Y", p + "Vector.Z", p + "Vector.W",
-          p + "Denoising Normal.X", p + "Denoising Normal.Y", p + "Denoising Normal.Z",
-          p + "Denoising Depth.Z"};
-}
-
 Names concat(std::initializer_list<Names> lists) {
   Names out;
   for (const Names& l : lists) out.insert(out.end(), l.begin(), l.end());
@@ -110,23 +104,6 @@ float written(const Names& channels, const std::string& name, int x, int y) {
   EXPECT_NE(it, channels.end()) << name;
   return value_of(x, y, int(it - channels.begin()));
 }
-
-template <class Fn>
-std::string expect_error(Errc code, Fn&& fn) {
-  try {
-    fn();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << "got " << errc_name(e.code()) << ": " << e.what();
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", got: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", nothing thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 // ---------------------------------------------------------------- reading
 

@@ -40,8 +40,6 @@ Image run_gauss(const Image& colour, double sigma, int nthreads = 0, Roi roi = {
   return run_on(frame_of(colour), {{"sigma", sigma}}, nthreads, roi).out;
 }
 
-bool finite_rgb(const float* p) { return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]); }
-
 // The documented kernel: exp(-d^2/(2 sigma^2)) over |dx|,|dy| <= ceil(3 sigma),
 // clipped at the borders and renormalised, non-finite pixels left out, 0 if none.
 void brute(const Image& in, int x, int y, double sigma, double out[3]) {
@@ -51,7 +49,7 @@ void brute(const Image& in, int x, int y, double sigma, double out[3]) {
     for (int xx = x - r; xx <= x + r; ++xx) {
       if (xx < 0 || yy < 0 || xx >= in.width() || yy >= in.height()) continue;
       const float* p = in.pixel(xx, yy);
-      if (!finite_rgb(p)) continue;
+      if (!testutil::finite_n(p, 3)) continue;
       const double d2 = double(xx - x) * (xx - x) + double(yy - y) * (yy - y);
       const double w = sigma > 0 ? std::exp(-d2 / (2 * sigma * sigma)) : 1.0;
       for (int c = 0; c < 3; ++c) s[c] += w * p[c];
@@ -62,17 +60,9 @@ void brute(const Image& in, int x, int y, double sigma, double out[3]) {
 
 void expect_brute(const Image& in, const Image& out, const std::function<double(int, int)>& sigma_at,
                   double rel = 2e-5) {
-  ASSERT_EQ(out.width(), in.width());
-  ASSERT_EQ(out.height(), in.height());
-  ASSERT_EQ(out.channels(), 3);
-  for (int y = 0; y < in.height(); ++y)
-    for (int x = 0; x < in.width(); ++x) {
-      double want[3];
-      brute(in, x, y, sigma_at(x, y), want);
-      for (int c = 0; c < 3; ++c)
-        ASSERT_NEAR(out.at(x, y, c), want[c], rel * std::max(1.0, std::fabs(want[c])))
-            << "pixel " << x << "," << y << " channel " << c << " sigma " << sigma_at(x, y);
-    }
+  testutil::expect_each_pixel_near(
+      in, out, [&](int x, int y, double want[3]) { brute(in, x, y, sigma_at(x, y), want); }, rel,
+      [&](int x, int y) { return testing::Message() << " sigma " << sigma_at(x, y); });
 }
 
 auto constant_sigma(double s) {
@@ -145,8 +135,7 @@ TEST(GaussianFilterTest, NonFinitePixelsGetWeightZero) {
   in.at(7, 2, 2) = -kInf;
   for (double s : {0.8, 2.0}) {
     Result r = run_on(frame_of(in), {{"sigma", s}});
-    EXPECT_EQ(r.repaired, 0u);
-    for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+    ASSERT_NO_FATAL_FAILURE(testutil::expect_finite_unrepaired(r));
     expect_brute(in, r.out, constant_sigma(s));
     EXPECT_LT(r.out.at(1, 0, 0), 1.5f);  // the 1000 never leaks
   }
@@ -180,8 +169,7 @@ TEST(GaussianFilterTest, TinyAndHugeValuesNeitherUnderflowNorOverflow) {
   Image big(20, 20, 3, FLT_MAX);
   big.at(3, 3, 1) = -FLT_MAX;
   Result b = run_on(frame_of(big), {{"sigma", 3.0}});
-  EXPECT_EQ(b.repaired, 0u);
-  for (float v : b.out.storage()) ASSERT_TRUE(std::isfinite(v));
+  ASSERT_NO_FATAL_FAILURE(testutil::expect_finite_unrepaired(b));
   EXPECT_NEAR(b.out.at(15, 15, 0), FLT_MAX, 1e-6 * FLT_MAX);
 }
 
@@ -192,9 +180,7 @@ TEST(GaussianFilterTest, ZeroAlbedoWithDemodulation) {
   a.name = "Denoising Albedo";
   a.image = Image(16, 16, 3, 0.0f);
   f.passes.push_back(a);
-  Result r = run_on(f, {{"sigma", 1.5}, {"demodulate", true}});
-  EXPECT_EQ(r.repaired, 0u);
-  for (float v : r.out.storage()) ASSERT_TRUE(std::isfinite(v));
+  testutil::expect_finite_unrepaired(run_on(f, {{"sigma", 1.5}, {"demodulate", true}}));
 }
 
 TEST(GaussianFilterTest, FireflyClamp) {
@@ -223,14 +209,8 @@ TEST(GaussianFilterTest, RegionChangesOnlyPixelsInside) {
   const Roi roi{7, 3, 19, 11};
   for (const Params& p : {Params{{"sigma", 1.5}},
                           Params{{"sigma", 0.5}, {"sigma_outer", 2.0}, {"foveated", true}, {"inner_radius", 0.05}}}) {
-    const Image part = run_on(frame_of(in), p, 0, roi).out;
-    const Image full = run_on(frame_of(in), p).out;
-    for (int y = 0; y < 20; ++y)
-      for (int x = 0; x < 30; ++x)
-        for (int c = 0; c < 3; ++c) {
-          const bool inside = x >= roi.x0 && x < roi.x1 && y >= roi.y0 && y < roi.y1;
-          ASSERT_EQ(part.at(x, y, c), inside ? full.at(x, y, c) : in.at(x, y, c)) << x << "," << y;
-        }
+    ASSERT_NO_FATAL_FAILURE(
+        testutil::expect_only_region_changed(run_on(frame_of(in), p, 0, roi).out, run_on(frame_of(in), p).out, in, roi));
   }
 }
 
@@ -254,15 +234,10 @@ TEST(GaussianFilterTest, FoveatedPathOnEveryInstructionSet) {
   GaussianFilter f;
   for (const auto& [k, v] : p) f.set(k, v);
   const Foveation fov(f.params(), 37, 29);
-  int ran = 0;
-  for (Isa level : {Isa::Generic, Isa::Avx2, Isa::Avx512}) {
-    if (int(level) > int(best_isa())) continue;
-    const ScopedIsa use(level);
-    SCOPED_TRACE(isa_name(level));
+  const int ran = testutil::for_each_isa([&](Isa) {
     expect_brute(in, run_on(frame_of(in), p).out, [&](int x, int y) { return fov.value("sigma", fov.blend_at(x, y)); },
                  1e-4);
-    ++ran;
-  }
+  });
   EXPECT_GE(ran, 1);
 }
 

@@ -19,6 +19,7 @@
 #include <string>
 #include <vector>
 
+#include "feature_filter_testutil.h"
 #include "filters/image/box.h"
 #include "filters/registry.h"
 #include "util/error.h"
@@ -26,8 +27,11 @@
 namespace mcr {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+using testutil::kInf;
+using testutil::kNaN;
+using testutil::named_pass;
+using testutil::Params;
+using testutil::random_image;
 
 // ---------------------------------------------------------------------------
 // Frames
@@ -36,33 +40,17 @@ struct Passes {
   Image colour, normal, depth, albedo, position;
 };
 
-Pass make_pass(Role role, const char* name, const Image& img) {
-  Pass p;
-  p.role = role;
-  p.name = name;
-  p.image = img;
-  return p;
-}
-
 Frame frame_of(const Passes& ps) {
   Frame f;
   f.width = ps.colour.width();
   f.height = ps.colour.height();
   f.path = "test.exr";
-  f.passes.push_back(make_pass(Role::Colour, "Combined", ps.colour));
-  if (!ps.normal.empty()) f.passes.push_back(make_pass(Role::Normal, "Normal", ps.normal));
-  if (!ps.depth.empty()) f.passes.push_back(make_pass(Role::Depth, "Depth", ps.depth));
-  if (!ps.albedo.empty()) f.passes.push_back(make_pass(Role::Albedo, "Albedo", ps.albedo));
-  if (!ps.position.empty()) f.passes.push_back(make_pass(Role::Position, "Position", ps.position));
+  f.passes.push_back(named_pass(Role::Colour, "Combined", ps.colour));
+  if (!ps.normal.empty()) f.passes.push_back(named_pass(Role::Normal, "Normal", ps.normal));
+  if (!ps.depth.empty()) f.passes.push_back(named_pass(Role::Depth, "Depth", ps.depth));
+  if (!ps.albedo.empty()) f.passes.push_back(named_pass(Role::Albedo, "Albedo", ps.albedo));
+  if (!ps.position.empty()) f.passes.push_back(named_pass(Role::Position, "Position", ps.position));
   return f;
-}
-
-Image random_image(int w, int h, int channels, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> dist(lo, hi);
-  Image im(w, h, channels);
-  for (float& v : im.storage()) v = dist(rng);
-  return im;
 }
 
 Image random_normals(int w, int h, unsigned seed) {
@@ -94,24 +82,15 @@ Passes random_passes(int w, int h, unsigned seed) {
   return ps;
 }
 
-using Params = std::map<std::string, ParamValue>;
-
-struct Result {
-  Image out;
-  std::size_t repaired = 0;
+// The shared run, plus the guided filter's statistics of that run.
+struct Result : testutil::Result {
   GuidedStats stats;
 };
 
 Result run_guided(const Frame& frame, const Params& params, int nthreads = 1, Roi roi = {}) {
   GuidedFilter f;
-  for (const auto& [k, v] : params) f.set(k, v);
-  f.commit();
-  ExecOptions eo;
-  eo.nthreads = nthreads;
-  eo.roi = roi;
   Result r;
-  r.out = f.execute(frame, eo);
-  r.repaired = f.nonfinite_repaired();
+  static_cast<testutil::Result&>(r) = testutil::run_filter(f, frame, params, nthreads, roi);
   r.stats = f.stats();
   return r;
 }

@@ -6,10 +6,14 @@
 #include <limits>
 #include <string>
 
+#include "expect_error.h"
 #include "util/error.h"
 
 namespace mcr {
 namespace {
+
+using testutil::contains;
+using testutil::expect_error;
 
 const ParamTable& table() {
   static const ParamTable t = {
@@ -22,24 +26,6 @@ const ParamTable& table() {
 }
 
 ParamSet params() { return ParamSet("testfilter", &table()); }
-
-// Runs fn, expects mcr::Error with that code, returns the message.
-template <class Fn>
-std::string expect_error(Errc code, Fn&& fn) {
-  try {
-    fn();
-  } catch (const Error& e) {
-    EXPECT_EQ(e.code(), code) << "got " << errc_name(e.code()) << ": " << e.what();
-    return e.what();
-  } catch (const std::exception& e) {
-    ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", got std::exception: " << e.what();
-    return "";
-  }
-  ADD_FAILURE() << "expected mcr::Error " << errc_name(code) << ", nothing thrown";
-  return "";
-}
-
-bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 TEST(ParamsTest, DefaultsAreFilledIn) {
   const ParamSet p = params();

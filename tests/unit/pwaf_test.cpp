@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
 #include "kernels/noise_variance.h"
@@ -20,32 +21,21 @@
 namespace mcr {
 namespace {
 
-constexpr float kInf = std::numeric_limits<float>::infinity();
-constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
-
-Pass make_pass(Role role, const char* name, const Image& im) {
-  Pass p;
-  p.role = role;
-  p.name = name;
-  p.image = im;
-  return p;
-}
+using testutil::kInf;
+using testutil::kNaN;
+using testutil::named_pass;
 
 Frame frame_of(const Image& colour) {
   Frame f;
   f.width = colour.width();
   f.height = colour.height();
   f.path = "test.exr";
-  f.passes.push_back(make_pass(Role::Colour, "Combined", colour));
+  f.passes.push_back(named_pass(Role::Colour, "Combined", colour));
   return f;
 }
 
 Image random_image(int w, int h, unsigned seed, float lo = 0.0f, float hi = 1.0f, int channels = 3) {
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> dist(lo, hi);
-  Image im(w, h, channels);
-  for (float& v : im.storage()) v = dist(rng);
-  return im;
+  return testutil::random_image(w, h, channels, seed, lo, hi);
 }
 
 // A frame with every feature pass, smooth geometry (two planes meeting at x = w/2).
@@ -61,35 +51,26 @@ Frame full_frame(int w, int h, unsigned seed, bool second = true, bool variance 
       p.at(x, y, 1) = 0.01f * y;
       p.at(x, y, 2) = left ? 1.0f : 1.0f + 0.01f * (x - w / 2);
     }
-  f.passes.push_back(make_pass(Role::Normal, "Normal", n));
-  f.passes.push_back(make_pass(Role::Position, "Position", p));
+  f.passes.push_back(named_pass(Role::Normal, "Normal", n));
+  f.passes.push_back(named_pass(Role::Position, "Position", p));
   if (second) {
-    f.passes.push_back(make_pass(Role::SecondNormal, "second_normal", n));
-    f.passes.push_back(make_pass(Role::SecondPosition, "second_position", p));
+    f.passes.push_back(named_pass(Role::SecondNormal, "second_normal", n));
+    f.passes.push_back(named_pass(Role::SecondPosition, "second_position", p));
   }
-  if (variance) f.passes.push_back(make_pass(Role::Variance, "variance", v));
+  if (variance) f.passes.push_back(named_pass(Role::Variance, "variance", v));
   return f;
 }
 
-struct PwafRun {
-  Image out;
-  std::vector<std::string> notes;
-  std::size_t repaired = 0;
+// The shared run, plus the filter's statistics of that run.
+struct PwafRun : testutil::Result {
   PwafStats stats;
 };
 
 PwafRun run_pwaf(const Frame& frame, const std::vector<std::pair<std::string, ParamValue>>& params = {}, int nthreads = 0,
              Roi roi = {}) {
   PwafFilter f;
-  for (const auto& [k, v] : params) f.set(k, v);
-  f.commit();
-  ExecOptions eo;
-  eo.nthreads = nthreads;
-  eo.roi = roi;
   PwafRun r;
-  r.out = f.execute(frame, eo);
-  r.notes = f.notes();
-  r.repaired = f.nonfinite_repaired();
+  static_cast<testutil::Result&>(r) = testutil::run_filter(f, frame, params, nthreads, roi);
   r.stats = f.stats();
   return r;
 }
@@ -213,7 +194,7 @@ TEST(PwafVarianceTest, VariancePassIsUsedWhenPresent) {
     for (int x = 16; x < 32; ++x)
       for (int c = 0; c < 3; ++c) im.at(x, y, c) = 0.1f;
   Frame f = frame_of(im);
-  f.passes.push_back(make_pass(Role::Variance, "variance", Image(32, 8, 1, 1e-8f)));
+  f.passes.push_back(named_pass(Role::Variance, "variance", Image(32, 8, 1, 1e-8f)));
   const PwafRun tight = run_pwaf(f, {{"adaptive", false}});
   EXPECT_TRUE(tight.stats.variance_from_pass);
   EXPECT_TRUE(tight.notes.size() == 3u) << "only the dropped weights are noted";
@@ -227,7 +208,7 @@ TEST(PwafVarianceTest, VariancePassFollowsDemodulation) {
   // Demodulating by a constant albedo 0.5 must be the same as filtering colour / 0.5 with the
   // variance / 0.25, then multiplying by 0.5: the pass is divided by albedo^2 too.
   Frame a = full_frame(20, 14, 36, true, true);
-  a.passes.push_back(make_pass(Role::Albedo, "albedo", Image(20, 14, 3, 0.5f)));
+  a.passes.push_back(named_pass(Role::Albedo, "albedo", Image(20, 14, 3, 0.5f)));
   Frame b = full_frame(20, 14, 36, true, true);
   for (Pass& p : b.passes) {
     if (p.role == Role::Colour)
@@ -388,7 +369,7 @@ TEST(PwafFilterTest, NormalEdgeIsPreserved) {
       n.at(x, y, left ? 2 : 0) = 1.0f;
     }
   Frame f = frame_of(im);
-  f.passes.push_back(make_pass(Role::Normal, "Normal", n));
+  f.passes.push_back(named_pass(Role::Normal, "Normal", n));
   const std::vector<std::pair<std::string, ParamValue>> common = {{"adaptive", false}, {"sigma_c", 1e6}};
   auto with_sigma_n = [&](double s) {
     auto p = common;
@@ -415,7 +396,7 @@ TEST(PwafFilterTest, SecondHitPositionEdgeIsPreserved) {
       sp.at(x, y, 2) = left ? 1.0f : 5.0f;
     }
   Frame f = frame_of(im);
-  f.passes.push_back(make_pass(Role::SecondPosition, "second_position", sp));
+  f.passes.push_back(named_pass(Role::SecondPosition, "second_position", sp));
   const PwafRun kept = run_pwaf(f, {{"adaptive", false}, {"sigma_c", 1e6}});
   const PwafRun blurred = run_pwaf(f, {{"adaptive", false}, {"sigma_c", 1e6}, {"sigma_sp", 1e6}});
   EXPECT_NEAR(kept.out.at(w / 2 - 1, 4, 0), 0.3f, 1e-4);
@@ -454,9 +435,9 @@ TEST(PwafNotesTest, FirstHitPositionStandsInForTheSecondHitPosition) {
   // that pass had been given as second_position.
   const Frame base = full_frame(20, 14, 34, false);
   Frame as_second = frame_of(base.image(Role::Colour));
-  as_second.passes.push_back(make_pass(Role::Normal, "Normal", base.image(Role::Normal)));
-  as_second.passes.push_back(make_pass(Role::SecondPosition, "second_position", base.image(Role::Position)));
-  as_second.passes.push_back(make_pass(Role::Variance, "variance", base.image(Role::Variance)));
+  as_second.passes.push_back(named_pass(Role::Normal, "Normal", base.image(Role::Normal)));
+  as_second.passes.push_back(named_pass(Role::SecondPosition, "second_position", base.image(Role::Position)));
+  as_second.passes.push_back(named_pass(Role::Variance, "variance", base.image(Role::Variance)));
   const PwafRun a = run_pwaf(base), b = run_pwaf(as_second);
   EXPECT_EQ(a.out.storage(), b.out.storage());
 }
@@ -466,14 +447,14 @@ TEST(PwafNotesTest, MissingSecondNormalDropsGsnRatherThanReusingTheFirstHitNorma
   // equals one with a constant second normal (Gsn = 1 everywhere).
   const Frame base = full_frame(20, 14, 35, false);
   Frame constant = base;
-  constant.passes.push_back(make_pass(Role::SecondNormal, "second_normal", Image(20, 14, 3, 0.5f)));
-  constant.passes.push_back(make_pass(Role::SecondPosition, "second_position", base.image(Role::Position)));
+  constant.passes.push_back(named_pass(Role::SecondNormal, "second_normal", Image(20, 14, 3, 0.5f)));
+  constant.passes.push_back(named_pass(Role::SecondPosition, "second_position", base.image(Role::Position)));
   const PwafRun a = run_pwaf(base), b = run_pwaf(constant);
   EXPECT_EQ(a.out.storage(), b.out.storage());
   // ...and differs from feeding the first-hit normal as the second normal.
   Frame reuse = base;
-  reuse.passes.push_back(make_pass(Role::SecondNormal, "second_normal", base.image(Role::Normal)));
-  reuse.passes.push_back(make_pass(Role::SecondPosition, "second_position", base.image(Role::Position)));
+  reuse.passes.push_back(named_pass(Role::SecondNormal, "second_normal", base.image(Role::Normal)));
+  reuse.passes.push_back(named_pass(Role::SecondPosition, "second_position", base.image(Role::Position)));
   const PwafRun c = run_pwaf(reuse, {{"sigma_n", 2.0}, {"sigma_sn", 0.5}});
   const PwafRun d = run_pwaf(base, {{"sigma_n", 2.0}, {"sigma_sn", 0.5}});
   EXPECT_NE(c.out.storage(), d.out.storage());
@@ -521,10 +502,10 @@ TEST(PwafStressTest, AllEqualFeaturesActLikeNoFeatures) {
   const Image colour = random_image(18, 14, 41);
   Frame plain = frame_of(colour);
   Frame same = plain;
-  same.passes.push_back(make_pass(Role::Normal, "Normal", Image(18, 14, 3, 0.3f)));
-  same.passes.push_back(make_pass(Role::Position, "Position", Image(18, 14, 3, 2.0f)));
-  same.passes.push_back(make_pass(Role::SecondNormal, "second_normal", Image(18, 14, 3, -1.0f)));
-  same.passes.push_back(make_pass(Role::SecondPosition, "second_position", Image(18, 14, 3, 7.0f)));
+  same.passes.push_back(named_pass(Role::Normal, "Normal", Image(18, 14, 3, 0.3f)));
+  same.passes.push_back(named_pass(Role::Position, "Position", Image(18, 14, 3, 2.0f)));
+  same.passes.push_back(named_pass(Role::SecondNormal, "second_normal", Image(18, 14, 3, -1.0f)));
+  same.passes.push_back(named_pass(Role::SecondPosition, "second_position", Image(18, 14, 3, 7.0f)));
   const PwafRun a = run_pwaf(plain), b = run_pwaf(same);
   EXPECT_EQ(a.out.storage(), b.out.storage());
   expect_clean(b, "equal features");
@@ -644,7 +625,7 @@ TEST(PwafStressTest, NonFiniteFeaturesSwitchTheirWeightOff) {
 
 TEST(PwafStressTest, ZeroAlbedoWithDemodulation) {
   Frame f = full_frame(16, 12, 50, true, false);
-  f.passes.push_back(make_pass(Role::Albedo, "albedo", Image(16, 12, 3, 0.0f)));
+  f.passes.push_back(named_pass(Role::Albedo, "albedo", Image(16, 12, 3, 0.0f)));
   const PwafRun r = run_pwaf(f, {{"demodulate", true}});
   expect_clean(r, "zero albedo");
   Frame g = f;
