@@ -39,11 +39,10 @@ int run_info(const InfoArgs& a) {
   // passes the file lacks, and the optional ones it has that they would use.
   nlohmann::json filters = nlohmann::json::array();
   for (const auto& name : filter_names()) {
-    const PassNeeds need = make_committed_filter(name, {})->needs();
+    const auto f = make_committed_filter(name, {});
     nlohmann::json missing = nlohmann::json::array(), uses = nlohmann::json::array();
-    for (Role r : need.required)
-      if (!frame.has(r)) missing.push_back(role_name(r));
-    for (Role r : need.optional)
+    for (Role r : f->missing_passes(frame)) missing.push_back(role_name(r));
+    for (Role r : f->needs().optional)
       if (frame.has(r)) uses.push_back(role_name(r));
     filters.push_back({{"name", name}, {"can_run", missing.empty()}, {"missing", missing}, {"uses", uses}});
   }

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 
-#include "kernels/feature_needs.h"
+#include "kernels/feature_guides.h"
+#include "kernels/foveation.h"
 #include "util/error.h"
 #include "util/isa.h"
 
@@ -32,7 +33,7 @@ void Filter::commit() {
 
 void Filter::unused_when(bool no_effect, const std::string& name, const std::string& why,
                          std::vector<std::string>& out) const {
-  if (no_effect && params_.was_set(name)) out.push_back(name + " has no effect " + why);
+  if (no_effect) report_unused(params_, name, why, out);
 }
 
 void PassNeeds::require(Role r, const std::string& setting) {
@@ -72,15 +73,14 @@ void check_passes(const PassNeeds& need, const Frame& frame, const std::string& 
 PassNeeds Filter::own_needs() const {
   PassNeeds n;
   for (Role r : info_.required) n.require(r);
-  // The feature block's use_<f>=on makes a pass required (no-op without the block).
-  std::vector<Role> req, opt;
+  // The feature block's use_<f>=on makes a pass required, use_<f>=off unused (no-op
+  // without the block).
+  std::vector<Role> req, off;
   std::vector<std::string> why;
-  feature_needs(params_, req, why, opt);
+  feature_needs(params_, req, why, off);
   for (std::size_t i = 0; i < req.size(); ++i) n.require(req[i], why[i]);
   for (Role r : info_.optional)
-    if (std::find(opt.begin(), opt.end(), r) != opt.end() || !params_.has(std::string("use_") + role_name(r)) ||
-        params_.get_enum(std::string("use_") + role_name(r)) != "off")
-      n.use(r);
+    if (std::find(off.begin(), off.end(), r) == off.end()) n.use(r);
   return n;
 }
 
@@ -116,7 +116,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   const int w = frame.width, h = frame.height;
   const Image& input = frame.image(Role::Colour);
   const Roi roi = options.roi.empty() ? Roi::all(w, h) : options.roi.clipped(w, h);
-  if (roi.empty()) {  // nothing to filter: the input as it is
+  if (roi.empty()) {  // nothing to filter: the input as it is (non-finite values to 0)
     prepared_ = Prepared{};
     Image out = rgb_copy(input, nthreads);
     repaired_ = finish(prepared_, input, roi, nthreads, out);

@@ -45,6 +45,33 @@ const char* feature_name(Feature f) {
   return "?";
 }
 
+void feature_needs(const ParamSet& params, std::vector<Role>& required, std::vector<std::string>& why,
+                   std::vector<Role>& off) {
+  for (Feature f : kFeatures) {
+    const std::string use = std::string("use_") + feature_name(f);
+    if (f == Feature::Colour || !params.has(use)) continue;
+    const std::string& mode = params.get_enum(use);
+    if (mode == "on") {
+      required.push_back(feature_role(f));
+      why.push_back(use + "=on");
+    } else if (mode == "off") {
+      off.push_back(feature_role(f));
+    }
+  }
+}
+
+std::vector<std::string> feature_unused(const ParamSet& params) {
+  std::vector<std::string> out;
+  for (Feature f : kFeatures) {
+    const std::string use = std::string("use_") + feature_name(f);
+    if (!params.has(use) || params.get_enum(use) != "off") continue;
+    const std::string sigma = std::string(feature_name(f)) + "_sigma";
+    report_unused(params, sigma, "with " + use + "=off", out);
+    report_unused(params, sigma + "_outer", "with " + use + "=off", out);
+  }
+  return out;
+}
+
 ParamTable feature_params(const FeatureDefaults& d) {
   static const char* what[kFeatureCount] = {
       "colour (range) weight, on the colour as filtered (after demodulation; it always exists, so auto = on)",

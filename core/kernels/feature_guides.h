@@ -40,6 +40,13 @@ ParamTable feature_params(const FeatureDefaults& defaults = {});
 // {"colour_sigma", "normal_sigma", ...}: the names to pass to with_foveation().
 std::vector<std::string> feature_sigma_names();
 
+// What the block says about passes (no-op without it): `required` gets the use_<f>=on
+// ones, each with its setting in `why` ("use_depth=on"); `off` the use_<f>=off ones.
+void feature_needs(const ParamSet& params, std::vector<Role>& required, std::vector<std::string>& why,
+                   std::vector<Role>& off);
+// "<f>_sigma has no effect with use_<f>=off" (and its _outer twin) for the settings given.
+std::vector<std::string> feature_unused(const ParamSet& params);
+
 // The feature guides of one execute(): every enabled feature whose pass exists,
 // copied to planes once. k_f(p) = 1/(2 sigma_f(p)^2) with the foveated sigma of
 // each pixel, and 0 where p's own value of f is not finite (that pixel then

@@ -37,6 +37,18 @@ void check_foveation_params(const ParamSet& params, const std::string& filter) {
                                                param_value_text(in) + "), got " + param_value_text(out));
 }
 
+std::vector<std::string> foveation_unused(const ParamSet& params) {
+  std::vector<std::string> out;
+  if (!params.has("foveated") || params.get_bool("foveated")) return out;
+  for (const auto& kv : params.values()) {
+    const std::string& n = kv.first;
+    const bool outer = n.size() > 6 && n.compare(n.size() - 6, 6, "_outer") == 0;
+    if (outer || n == "gaze_x" || n == "gaze_y" || n == "inner_radius" || n == "outer_radius")
+      report_unused(params, n, "with foveated=false", out);
+  }
+  return out;
+}
+
 Foveation::Foveation(const ParamSet& params, int width, int height) : params_(params) {
   enabled_ = params.get_bool("foveated");
   const double diag = std::sqrt(double(width) * width + double(height) * height);

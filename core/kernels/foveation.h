@@ -35,6 +35,10 @@ ParamTable with_foveation(ParamTable own, const std::vector<std::string>& foveat
 // Errc::ParameterOutOfRange naming the filter. Call from check_params().
 void check_foveation_params(const ParamSet& params, const std::string& filter);
 
+// Without foveated=true: every _outer twin, gaze_x, gaze_y, inner_radius, outer_radius given
+// ("sigma_outer has no effect with foveated=false").
+std::vector<std::string> foveation_unused(const ParamSet& params);
+
 // The inner/outer pair of one parameter, looked up once (not per pixel).
 struct FoveatedValue {
   double inner = 0, outer = 0;

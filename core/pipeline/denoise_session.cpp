@@ -27,11 +27,13 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
                                const WriteOptions& write, const ExecOptions& exec) {
   StageTimes t;
   auto t0 = std::chrono::steady_clock::now();
-  const Frame frame = read_frame(input, read);
+  Frame frame = read_frame(input, read);
   t.read_ms = ms_since(t0);
 
   t0 = std::chrono::steady_clock::now();
-  const Image result = reconstruction_.run(frame, exec);
+  // The frame is ours: with accumulation its colour becomes the accumulated one, which
+  // the writer never reads (it takes alpha and the other channels from it).
+  const Image result = reconstruction_.run_in_place(frame, exec);
   t.filter_ms = ms_since(t0);
 
   if (!output.empty()) {

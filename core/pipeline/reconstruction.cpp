@@ -36,21 +36,27 @@ PassNeeds Reconstruction::needs() const {
 }
 
 Image Reconstruction::run(const Frame& frame, const ExecOptions& options) {
+  if (!accumulate_) {
+    notes_.clear();
+    return filter_->execute(frame, options);
+  }
+  Frame copy = frame;  // the accumulated colour replaces the copy's, not the caller's
+  return run_in_place(copy, options);
+}
+
+Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options) {
   notes_.clear();
   if (!accumulate_) return filter_->execute(frame, options);
   // Accumulation's passes first: nothing is accumulated for a frame the filter refuses.
   check_passes(needs(), frame, "filter '" + filter_->info().name + "' with accumulation");
-  Frame accumulated = frame;
-  Pass colour = accumulated.get(Role::Colour);
-  const Image& in = colour.image;
-  const Image& acc = accumulator_.accumulate(frame, in.channels() == 3 ? in : in.channel_range(0, 3), options.nthreads);
-  const std::size_t ch = std::size_t(in.channels());
+  Image& colour = frame.passes[std::size_t(&frame.get(Role::Colour) - frame.passes.data())].image;
+  const Image& acc =
+      accumulator_.accumulate(frame, colour.channels() == 3 ? colour : colour.channel_range(0, 3), options.nthreads);
+  const std::size_t ch = std::size_t(colour.channels());
   for (std::size_t i = 0; i < acc.pixel_count(); ++i)
-    for (std::size_t c = 0; c < 3; ++c) colour.image.data()[i * ch + c] = acc.data()[i * 3 + c];
-  accumulated.put(std::move(colour));
-  const Reprojection& rep = accumulator_.last_reprojection();
-  if (rep.cut) notes_.push_back("accumulation: camera cut, history restarted");
-  return filter_->execute(accumulated, options);
+    for (std::size_t c = 0; c < 3; ++c) colour.data()[i * ch + c] = acc.data()[i * 3 + c];
+  if (accumulator_.last_reprojection().cut) notes_.push_back("accumulation: camera cut, history restarted");
+  return filter_->execute(frame, options);
 }
 
 void Reconstruction::reset() {

@@ -30,6 +30,9 @@ class Reconstruction {
   // Checks the passes (MissingPass naming the frame's file, before any work), accumulates
   // when asked, runs the filter.
   Image run(const Frame& frame, const ExecOptions& options = {});
+  // The same without copying the frame: with accumulation its colour pass's RGB becomes
+  // the accumulated one (alpha and other channels kept).
+  Image run_in_place(Frame& frame, const ExecOptions& options = {});
   // Drops the history of both stages (new shot, frames out of order).
   void reset();
 

@@ -46,9 +46,6 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
 
 namespace {
 
-double fval(const ParamSet& p, const char* name) { return p.has(name) ? p.get_float(name) : 0.0; }
-bool demodulating(const ParamSet& p) { return p.has("demodulate") && p.get_bool("demodulate"); }
-
 Role hole_role(const std::string& mode) { return mode == "alpha" ? Role::Alpha : Role::SampleCount; }
 
 // Weight 0 for unsampled pixels, 1 otherwise; empty when nothing is missing.
@@ -83,11 +80,11 @@ Frame& own_frame(const Frame& frame, Prepared& out) {
 
 void preparation_needs(const ParamSet& params, const PrepSteps& steps, std::vector<Role>& required,
                        std::vector<std::string>& why, std::vector<Role>& optional) {
-  if (steps.demodulate && demodulating(params)) {
+  if (steps.demodulate && params.get_bool("demodulate")) {
     required.push_back(Role::Albedo);
     why.push_back("demodulate=true");
   }
-  if (steps.albedo_prefilter && fval(params, "albedo_prefilter") > 0) {
+  if (steps.albedo_prefilter && params.get_float("albedo_prefilter") > 0) {
     for (Role r : {Role::Albedo, Role::Normal, Role::Position}) optional.push_back(r);
   }
   if (steps.holes) {
@@ -103,13 +100,11 @@ void preparation_needs(const ParamSet& params, const PrepSteps& steps, std::vect
 
 std::vector<std::string> preparation_unused(const ParamSet& params, const PrepSteps& steps) {
   std::vector<std::string> notes;
-  auto unused = [&](const char* name, const std::string& why) {
-    if (params.has(name) && params.was_set(name)) notes.push_back(std::string(name) + " has no effect " + why);
-  };
-  if (steps.outliers && !(fval(params, "firefly_k") > 0)) unused("firefly_radius", "with firefly_k=0");
-  if (steps.albedo_prefilter && !(fval(params, "albedo_prefilter") > 0))
-    unused("albedo_prefilter_position", "with albedo_prefilter=0");
-  if (steps.demodulate && !demodulating(params)) unused("albedo_floor", "with demodulate=false");
+  if (steps.outliers && !(params.get_float("firefly_k") > 0))
+    report_unused(params, "firefly_radius", "with firefly_k=0", notes);
+  if (steps.albedo_prefilter && !(params.get_float("albedo_prefilter") > 0))
+    report_unused(params, "albedo_prefilter_position", "with albedo_prefilter=0", notes);
+  if (steps.demodulate && !params.get_bool("demodulate")) report_unused(params, "albedo_floor", "with demodulate=false", notes);
   return notes;
 }
 
@@ -198,12 +193,16 @@ std::size_t finish(const Prepared& prepared, const Image& input, const Roi& roi,
     const bool inside_rows = y >= roi.y0 && y < roi.y1;
     // Outside the roi: the input colour, bit for bit.
     const float* in = input.pixel(0, y);
-    for (int x = 0; x < w; ++x) {
-      if (inside_rows && x >= roi.x0 && x < roi.x1) {
-        x = roi.x1 - 1;
-        continue;
-      }
-      for (int c = 0; c < 3; ++c) o[std::size_t(x) * 3 + std::size_t(c)] = in[std::size_t(x) * std::size_t(ich) + std::size_t(c)];
+    auto keep_input = [&](int x0, int x1) {
+      for (int x = x0; x < x1; ++x)
+        for (int c = 0; c < 3; ++c)
+          o[std::size_t(x) * 3 + std::size_t(c)] = in[std::size_t(x) * std::size_t(ich) + std::size_t(c)];
+    };
+    if (inside_rows) {
+      keep_input(0, roi.x0);
+      keep_input(roi.x1, w);
+    } else {
+      keep_input(0, w);
     }
     if (inside_rows && !prepared.divisor.empty()) {
       const float* al = prepared.divisor.pixel(roi.x0, y);

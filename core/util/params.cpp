@@ -43,6 +43,11 @@ ParamSpec ParamSpec::Enum(std::string name, std::string def, std::vector<std::st
   return s;
 }
 
+void report_unused(const ParamSet& params, const std::string& name, const std::string& why,
+                   std::vector<std::string>& out) {
+  if (params.has(name) && params.was_set(name)) out.push_back(name + " has no effect " + why);
+}
+
 std::string param_value_text(const ParamValue& v) {
   if (auto i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);
   if (auto d = std::get_if<double>(&v)) {

@@ -58,6 +58,11 @@ class ParamSet {
   std::set<std::string> given_;
 };
 
+// Appends "<name> has no effect <why>" to `out` when the setting was given (a default is
+// never reported): the unused-setting report of every filter and step.
+void report_unused(const ParamSet& params, const std::string& name, const std::string& why,
+                   std::vector<std::string>& out);
+
 std::string param_value_text(const ParamValue& v);  // "5", "0.25", "true", "gaussian"
 // "[0, 64]" for numbers, "one of: a, b" for enums, "" for bools.
 std::string param_range_text(const ParamSpec& s);
