@@ -1,10 +1,10 @@
 #include <cstdio>
 #include <filesystem>
-#include <fstream>
 #include <iostream>
 
 #include "commands.h"
 #include "filters/registry.h"
+#include "io/atomic_write.h"
 #include "io/preview.h"
 #include "io/sample_manifest.h"
 #include "json_views.h"
@@ -106,7 +106,7 @@ int run_demo(const DemoArgs& a) {
     }
   }
   const std::string json_path = (std::filesystem::path(a.out) / "results.json").string();
-  std::ofstream(json_path) << report.dump(2) << "\n";
+  write_text_atomic(report.dump(2) + "\n", json_path);
   std::fprintf(stderr, "wrote %s\n", json_path.c_str());
   if (a.json) std::cout << report.dump(2) << "\n";
   return 0;

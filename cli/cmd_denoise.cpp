@@ -94,7 +94,8 @@ int run_denoise(const DenoiseArgs& a) {
   }
   std::vector<std::string> outputs;
   for (const auto& j : jobs) outputs.push_back(j.second);
-  check_output_paths(outputs, inputs);
+  if (seq) check_sequence_outputs(a.output, parse_frame_range(a.frames), inputs);  // every frame its own file
+  else check_output_paths(outputs, inputs);
 
   const bool temporal = session.reconstruction().temporal();
   // Settings that change nothing: said once, not per frame.

@@ -10,7 +10,7 @@
 
 namespace {
 
-// Ctrl-C or kill mid-write: remove the temp file so no partial output remains.
+// Ctrl-C or kill mid-write: remove the temp files so no partial output remains.
 extern "C" void on_signal(int sig) {
   mcr::remove_pending_temp();
   std::signal(sig, SIG_DFL);
@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   std::signal(SIGHUP, on_signal);
+  // Over `ulimit -f`: a write fails with EFBIG (message, temp removed) instead of a kill.
+  std::signal(SIGXFSZ, SIG_IGN);
 
   CLI::App app{"mcrecon: reconstruct clean images from noisy Monte Carlo renders"};
   app.require_subcommand(1);

@@ -31,6 +31,7 @@
 #include "history.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
+#include "io/output_guard.h"
 #include "io/spec_window.h"
 #include "pipeline/denoise_session.h"
 #include "request.h"
@@ -330,6 +331,10 @@ class McreconOutput final : public ImageOutput {
       m_spec.channelformats.clear();
       name_ = name;
       shown_name_ = mp::strip_oiiotool_temp(name);
+      // oiiotool renames its temp over the name the user gave: that one must be a
+      // regular file or a new path too (never a device node, FIFO or directory).
+      mcr::check_output_path(shown_name_, {});
+      if (name_ != shown_name_) mcr::check_output_target(name_);
       pixels_.assign(std::size_t(spec.width) * spec.height * spec.nchannels, 0.0f);
       rows_.assign(std::size_t(spec.height), false);
       rows_left_ = spec.height;

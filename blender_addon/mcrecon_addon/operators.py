@@ -4,7 +4,7 @@ import os
 
 import bpy
 
-from . import native, pass_output, properties, render_hooks
+from . import native, pass_output, properties
 
 
 _ITEMS = []  # Blender needs the strings of dynamic enum items kept alive
@@ -53,28 +53,27 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
             self.report({"ERROR"}, f"mcrecon: empty frame range {self.frame_start}-{self.frame_end}")
             return {"CANCELLED"}
         wm = context.window_manager
+        params = properties.filter_params(context.scene.mcrecon, self.filter)
+        # The core checks the outputs before any frame is filtered (never an input, every frame its
+        # own regular file or new path): an error is reported, nothing is written.
         try:
-            session = mc.Session(self.filter, properties.filter_params(context.scene.mcrecon, self.filter),
-                                 accumulate=self.accumulate)
-            jobs = [(render_hooks.frame_path(src, f) if seq else src, render_hooks.frame_path(out, f) if seq else out)
-                    for f in frames]
-            missing = [i for i, _ in jobs if not os.path.exists(i)]
-            if missing:
-                err = mc.Error(f"cannot read '{missing[0]}': no such file ({len(missing)} missing)")
-                err.kind = "file_not_found"
-                raise err
-            wm.progress_begin(0, len(jobs))
+            wm.progress_begin(0, len(frames))
             try:
-                for n, (i, o) in enumerate(jobs, 1):
-                    t = session.denoise_file(i, o)
-                    wm.progress_update(n)
-                    print(f"mcrecon: [{n}/{len(jobs)}] {o} ({t['total_ms']:.0f} ms)", flush=True)
+                if seq:
+                    def progress(n, total, o):
+                        wm.progress_update(n)
+                        print(f"mcrecon: [{n}/{total}] {o}", flush=True)
+                    mc.denoise_sequence(src, out, self.frame_start, self.frame_end, self.filter, params,
+                                        progress=progress, accumulate=self.accumulate)
+                else:
+                    t = mc.Session(self.filter, params, accumulate=self.accumulate).denoise_file(src, out)
+                    print(f"mcrecon: {out} ({t['total_ms']:.0f} ms)", flush=True)
             finally:
                 wm.progress_end()
         except mc.Error as e:
             self.report({"ERROR"}, f"mcrecon: {e} [{e.kind}]")
             return {"CANCELLED"}
-        self.report({"INFO"}, f"mcrecon: {len(jobs)} file(s) denoised with {self.filter}")
+        self.report({"INFO"}, f"mcrecon: {len(frames)} file(s) denoised with {self.filter}")
         return {"FINISHED"}
 
 

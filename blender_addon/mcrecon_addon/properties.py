@@ -123,7 +123,9 @@ def _base_annotations():
             description="Run the mcrecon filter after every render (reads the passes from the multilayer EXR)"),
         "output_path": bpy.props.StringProperty(
             name="Output", subtype="FILE_PATH", default="",
-            description="Denoised output (#### = frame); empty: <render>_denoised.exr next to the render"),
+            description="Denoised output (#### = frame; without #, an animation's frames get the frame number "
+                        "before the extension, as Blender numbers its own: out0001.exr); never the render itself; "
+                        "empty: <render>_denoised.exr next to the render"),
         "accumulate": bpy.props.BoolProperty(
             name="Accumulate", default=False, update=_on_filter_change,
             description="Temporally accumulate the noisy colour across the frames of an animation before the "

@@ -8,12 +8,12 @@ in order, with their history; a frame that does not follow the last one denoised
 frame_step > 1, or a frame after a failed one) starts a fresh history. Errors become console
 messages and scene.mcrecon.last_message; they never stop Blender writing the render."""
 import os
-import re
 
 import bpy
 from bpy.app.handlers import persistent
 
 from . import native, pass_output, properties
+from .output_paths import frame_path, output_for_frame  # noqa: F401 (frame_path: operators)
 
 RESULT_IMAGE = "mcrecon Result"
 _job = {"session": None, "key": None, "next": None}  # next: the frame that continues the history
@@ -34,13 +34,6 @@ def log(scene, text, error=False):
             pass
 
 
-def frame_path(pattern, frame):
-    """'#' runs become the zero-padded frame number."""
-    if "#" in pattern:
-        return re.sub(r"#+", lambda m: str(frame).zfill(len(m.group(0))), pattern)
-    return pattern
-
-
 def written_path(scene):
     """The file the render just wrote. Stills (write_still) use render.filepath as it is (plus the
     extension); animations substitute #### (or append the frame): take the newer of the two."""
@@ -59,9 +52,13 @@ def written_path(scene):
 def output_for(scene, render_path):
     mc = scene.mcrecon
     if mc.output_path:
-        out = bpy.path.abspath(mc.output_path)
-        out = frame_path(out, scene.frame_current)  # animations: put #### in output_path
-        return out if out.lower().endswith(".exr") else out + ".exr"
+        # An animation: a range of frames, and Blender numbered the render's own file. Then an
+        # output without '#' is numbered too (output_paths.output_for_frame), never one file
+        # written over by every frame.
+        frame = scene.frame_current
+        animation = (scene.frame_end > scene.frame_start
+                     and os.path.abspath(render_path) == os.path.abspath(scene.render.frame_path(frame=frame)))
+        return output_for_frame(bpy.path.abspath(mc.output_path), frame, animation)
     stem, _ = os.path.splitext(render_path)
     return stem + "_denoised.exr"
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "filters/registry.h"
+#include "io/output_guard.h"
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
 #include "util/error.h"
@@ -405,19 +406,27 @@ PYBIND11_MODULE(mcrecon, m) {
           throw mcr::Error(Errc::InvalidArgument, "input and output must be sequence patterns (#### or %04d)");
         if (last < first) throw mcr::Error(Errc::InvalidArgument, "frame range " + std::to_string(first) + "-" +
                                                                         std::to_string(last) + " is empty");
-        for (int f = first; f <= last; ++f) {  // every input checked before the first is filtered
-          const std::string in = mcr::sequence_path(input, f);
+        // Every input, and every output against them all, checked before the first frame is
+        // filtered (as the CLI does); long long: a range ending at INT_MAX ends.
+        std::vector<std::string> inputs;
+        for (long long f = first; f <= last; ++f) {
+          inputs.push_back(mcr::sequence_path(input, int(f)));
           std::error_code ec;
-          if (!std::filesystem::exists(in, ec))
-            throw mcr::Error(Errc::FileNotFound, "cannot read '" + in + "': no such file");
+          if (!std::filesystem::exists(inputs.back(), ec))
+            throw mcr::Error(Errc::FileNotFound, "cannot read '" + inputs.back() + "': no such file");
         }
+        for (const mcr::PassOverride& o : read_options(layer, passes).overrides) {  // loose pass files
+          std::error_code ec;
+          if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
+        }
+        mcr::check_sequence_outputs(output, {first, last}, inputs);
         Session s(filter, params, threads, accumulate);
         py::list outputs;
-        for (int f = first; f <= last; ++f) {
-          const std::string out = mcr::sequence_path(output, f);
-          s.denoise_file(mcr::sequence_path(input, f), out, layer, passes, false);
+        for (long long f = first; f <= last; ++f) {
+          const std::string out = mcr::sequence_path(output, int(f));
+          s.denoise_file(inputs[std::size_t(f - first)], out, layer, passes, false);
           outputs.append(out);
-          if (progress) (*progress)(f - first + 1, last - first + 1, out);
+          if (progress) (*progress)(int(f - first + 1), int((long long)last - first + 1), out);
         }
         return outputs;
       },

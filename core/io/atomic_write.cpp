@@ -1,13 +1,21 @@
 #include "io/atomic_write.h"
 
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <OpenImageIO/filesystem.h>
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cerrno>
+#include <climits>
 #include <csignal>
 #include <cstring>
 #include <filesystem>
-#include <map>
-#include <utility>
+#include <mutex>
+#include <random>
 
 #include "util/error.h"
 
@@ -16,99 +24,222 @@ namespace mcr {
 namespace fs = std::filesystem;
 
 namespace {
-// The temp file currently being written, readable from a signal handler.
-char g_pending[4096];
-volatile std::sig_atomic_t g_has_pending = 0;
 
-void set_pending(const std::string& p) {
-  g_has_pending = 0;
-  std::strncpy(g_pending, p.c_str(), sizeof(g_pending) - 1);
-  g_pending[sizeof(g_pending) - 1] = '\0';
-  g_has_pending = 1;
+// The temps being written, readable from a signal handler: one slot per write in
+// flight (threads of the Python module may write several at once).
+struct Slot {
+  std::atomic<int> state{0};  // 0 free, 1 being filled, 2 holds a temp path
+  char path[PATH_MAX];
+};
+static_assert(std::atomic<int>::is_always_lock_free, "signal handlers need lock-free atomics");
+constexpr int kSlots = 32;
+Slot g_slots[kSlots];
+
+int claim_slot(const std::string& p) {
+  if (p.size() >= PATH_MAX) return -1;
+  for (int i = 0; i < kSlots; ++i) {
+    int expected = 0;
+    if (!g_slots[i].state.compare_exchange_strong(expected, 1)) continue;
+    std::memcpy(g_slots[i].path, p.c_str(), p.size() + 1);
+    g_slots[i].state.store(2);
+    return i;
+  }
+  return -1;  // more writes in flight than slots: that temp is not removed on a signal
 }
 
-std::string temp_prefix(const fs::path& target) {
-  return "." + target.filename().string() + ".mcrecon-tmp.";
+// ".mcrecon-tmp." + pid (10 digits at most) + "." + counter + "." + 8 hex digits.
+constexpr std::size_t kTailMax = 48;
+constexpr const char* kMarker = ".mcrecon-tmp.";
+
+// The visible part of a temp name: the target's name, cut (at a UTF-8 character
+// boundary) so that "." + it + the tail fits NAME_MAX.
+std::string visible_part(const std::string& name) {
+  std::size_t n = std::min(name.size(), std::size_t(NAME_MAX) - 1 - kTailMax);
+  while (n > 0 && n < name.size() && (static_cast<unsigned char>(name[n]) & 0xC0) == 0x80) --n;
+  return name.substr(0, n);
 }
+
+fs::path dir_of(const std::string& path) {
+  const fs::path d = fs::path(path).parent_path();
+  return d.empty() ? fs::path(".") : d;
+}
+
+std::string unique_suffix() {
+  static std::atomic<unsigned long> counter{0};
+  static std::mutex mutex;
+  static std::mt19937 rng{std::random_device{}()};
+  unsigned r;
+  {
+    std::lock_guard<std::mutex> lock(mutex);
+    r = unsigned(rng());
+  }
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%ld.%lu.%08x", long(::getpid()), counter.fetch_add(1), r);
+  return buf;
+}
+
+// Temps of this target left by runs that were killed: the owning pid is encoded in
+// the name, and only the temps of processes that no longer exist are removed (a
+// concurrent run's temp is live and stays).
+void remove_stale_temps(const std::string& path) {
+  const std::string prefix = temp_prefix_for(path);
+  std::error_code ec;
+  fs::directory_iterator it(dir_of(path), ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const std::size_t digits = name.find_first_not_of("0123456789", prefix.size());
+    const std::string pid_text = name.substr(prefix.size(), digits == std::string::npos ? digits : digits - prefix.size());
+    if (pid_text.empty() || pid_text.size() > 9 || (digits != std::string::npos && name[digits] != '.')) continue;
+    const long pid = std::stol(pid_text);
+    if (pid <= 0 || ::kill(pid_t(pid), 0) == 0 || errno != ESRCH) continue;  // alive (or not ours to judge)
+    struct stat st;
+    if (::lstat(it->path().c_str(), &st) == 0 && S_ISREG(st.st_mode)) ::unlink(it->path().c_str());
+  }
+}
+
+// A temp file of this run, created exclusively; removed unless committed.
+class TempFile {
+ public:
+  explicit TempFile(const std::string& target) : target_(target) {
+    const fs::path dir = dir_of(target);
+    for (int attempt = 0; fd_ < 0; ++attempt) {
+      path_ = (dir / (temp_prefix_for(target) + unique_suffix())).string();
+      fd_ = ::open(path_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+      if (fd_ < 0 && (errno != EEXIST || attempt == 100))
+        throw Error(Errc::WriteFailed, "cannot write '" + target + "': cannot create a temp file in '" +
+                                           dir.string() + "': " + write_error_text(errno));
+    }
+    slot_ = claim_slot(path_);
+  }
+  ~TempFile() {
+    if (fd_ >= 0) ::close(fd_);
+    if (!committed_) ::unlink(path_.c_str());
+    if (slot_ >= 0) g_slots[slot_].state.store(0);
+  }
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+
+  int fd() const { return fd_; }
+  const std::string& path() const { return path_; }
+
+  // Closes (reporting a late write error) and renames over the target.
+  void commit() {
+    const int fd = fd_;
+    fd_ = -1;
+    if (::close(fd) != 0) fail(errno);
+    check_output_target(target_);  // replaced by a device or a directory meanwhile?
+    if (::rename(path_.c_str(), target_.c_str()) != 0) fail(errno);
+    committed_ = true;
+  }
+  [[noreturn]] void fail(int err) const {
+    throw Error(Errc::WriteFailed, "cannot write '" + target_ + "': " + write_error_text(err));
+  }
+
+ private:
+  std::string target_, path_;
+  int fd_ = -1, slot_ = -1;
+  bool committed_ = false;
+};
+
+// OIIO writes the file through this proxy to our exclusively created descriptor, so
+// the first system error (ENOSPC, EFBIG, ...) is known exactly.
+class FdOutput final : public OIIO::Filesystem::IOProxy {
+ public:
+  FdOutput(int fd, const std::string& name) : IOProxy(name, Write), fd_(fd) {}
+  const char* proxytype() const override { return "mcrecon-fd"; }
+  size_t write(const void* buf, size_t size) override {
+    const size_t n = pwrite(buf, size, m_pos);
+    m_pos += int64_t(n);
+    return n;
+  }
+  size_t pwrite(const void* buf, size_t size, int64_t offset) override {
+    std::lock_guard<std::mutex> lock(mutex_);
+    size_t done = 0;
+    while (done < size && err_ == 0) {
+      const ssize_t n = ::pwrite(fd_, static_cast<const char*>(buf) + done, size - done, off_t(offset + done));
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) err_ = n < 0 ? errno : EIO;
+      else done += size_t(n);
+    }
+    end_ = std::max(end_, size_t(offset) + done);
+    return done;
+  }
+  size_t read(void*, size_t) override { return 0; }
+  size_t pread(void*, size_t, int64_t) override { return 0; }
+  size_t size() const override { return end_; }
+  int err() const { return err_; }
+
+ private:
+  int fd_;
+  std::mutex mutex_;
+  size_t end_ = 0;
+  int err_ = 0;
+};
+
+std::string format_for(const std::string& path, const std::string& format) {
+  if (!format.empty()) return format;
+  const std::string ext = fs::path(path).extension().string();
+  if (ext.size() <= 1 || ext == ".exr") return "openexr";
+  return ext.substr(1);
+}
+
+// Every writer's steps: guard the target, clear dead runs' temps, write a temp of
+// our own, rename it over the target.
+template <class Body>
+void write_via_temp(const std::string& path, Body&& body) {
+  if (path.empty()) throw Error(Errc::InvalidArgument, "no output path given");
+  check_output_target(path);
+  remove_stale_temps(path);
+  TempFile tmp(path);
+  body(tmp);
+  tmp.commit();
+}
+
 }  // namespace
 
-std::string temp_path_for(const std::string& path) {
-  const fs::path target(path);
-  return (target.parent_path() / (temp_prefix(target) + std::to_string(::getpid()))).string();
+std::string temp_prefix_for(const std::string& path) {
+  return "." + visible_part(fs::path(path).filename().string()) + kMarker;
 }
 
 void remove_pending_temp() noexcept {
-  if (g_has_pending) ::unlink(g_pending);
+  for (Slot& s : g_slots)
+    if (s.state.load() == 2) ::unlink(s.path);
 }
 
-void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
-  // Each input once (a sequence checks every output against every input): its
-  // canonical path, and its file identity when it exists (hard links).
-  std::map<fs::path, const std::string*> by_path;
-  std::map<std::pair<dev_t, ino_t>, const std::string*> by_id;
-  for (const std::string& in : inputs) {
-    std::error_code ec;
-    const fs::path p = fs::weakly_canonical(fs::absolute(in), ec);
-    if (!ec) by_path.emplace(p, &in);
-    struct stat st;
-    if (::stat(in.c_str(), &st) == 0) by_id.emplace(std::make_pair(st.st_dev, st.st_ino), &in);
-  }
-  for (const std::string& output : outputs) {
-    if (output.empty()) throw Error(Errc::InvalidArgument, "no output path given");
-    std::error_code ec;
-    const std::string* same = nullptr;
-    const fs::path out = fs::weakly_canonical(fs::absolute(output), ec);
-    if (!ec)
-      if (auto it = by_path.find(out); it != by_path.end()) same = it->second;
-    struct stat st;
-    if (!same && ::stat(output.c_str(), &st) == 0)
-      if (auto it = by_id.find(std::make_pair(st.st_dev, st.st_ino)); it != by_id.end()) same = it->second;
-    if (same)
-      throw Error(Errc::InvalidArgument, "output '" + output + "' is the input '" + *same + "': inputs are never overwritten");
-    fs::path dir = fs::absolute(output).parent_path();
-    if (!fs::is_directory(dir, ec))
-      throw Error(Errc::WriteFailed, "cannot write '" + output + "': directory '" + dir.string() + "' does not exist");
-    if (::access(dir.c_str(), W_OK) != 0)
-      throw Error(Errc::WriteFailed, "cannot write '" + output + "': directory '" + dir.string() + "' is not writable");
-    if (fs::is_directory(output, ec))
-      throw Error(Errc::WriteFailed, "cannot write '" + output + "': it is a directory");
-  }
+void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std::string& format,
+                  OIIO::TypeDesc dtype) {
+  const std::string fmt = format_for(path, format);
+  write_via_temp(path, [&](TempFile& tmp) {
+    FdOutput proxy(tmp.fd(), tmp.path());  // outlives `out`, which may use it until destroyed
+    auto out = OIIO::ImageOutput::create(fmt);
+    if (!out) throw Error(Errc::WriteFailed, "cannot write '" + path + "': no writer for format '" + fmt + "'");
+    if (!out->supports("ioproxy"))
+      throw Error(Errc::Internal, "cannot write '" + path + "': the " + fmt + " writer takes no I/O proxy");
+    out->set_ioproxy(&proxy);
+    OIIO::ImageSpec spec = buf.spec();
+    if (dtype != OIIO::TypeUnknown) spec.set_format(dtype);
+    bool ok = out->open(tmp.path(), spec) && buf.write(out.get());
+    ok = out->close() && ok;
+    if (proxy.err()) tmp.fail(proxy.err());
+    if (!ok) {
+      std::string msg = out->geterror();
+      if (const std::string b = buf.geterror(); !b.empty()) msg += (msg.empty() ? "" : "; ") + b;
+      throw Error(Errc::WriteFailed, "cannot write '" + path + "': " + msg);
+    }
+  });
 }
 
-void check_output_path(const std::string& output, const std::vector<std::string>& inputs) {
-  check_output_paths({output}, inputs);
-}
-
-void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std::string& format) {
-  const fs::path target(path);
-  std::error_code ec;
-  // Leftovers of killed runs for this target.
-  const fs::path dir = target.parent_path().empty() ? fs::path(".") : target.parent_path();
-  const std::string prefix = temp_prefix(target);
-  for (const auto& e : fs::directory_iterator(dir, ec))
-    if (e.path().filename().string().rfind(prefix, 0) == 0) fs::remove(e.path(), ec);
-
-  const std::string tmp = temp_path_for(path);
-  std::string fmt = format;
-  if (fmt.empty()) {
-    std::string ext = target.extension().string();
-    fmt = ext.size() > 1 ? ext.substr(1) : "openexr";
-    if (fmt == "exr") fmt = "openexr";
-  }
-  set_pending(tmp);
-  const bool ok = buf.write(tmp, OIIO::TypeUnknown, fmt);
-  if (!ok) {
-    const std::string msg = buf.geterror();
-    fs::remove(tmp, ec);
-    g_has_pending = 0;
-    throw Error(Errc::WriteFailed, "cannot write '" + path + "': " + msg);
-  }
-  fs::rename(tmp, target, ec);
-  g_has_pending = 0;
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error(Errc::WriteFailed, "cannot write '" + path + "': rename failed: " + ec.message());
-  }
+void write_text_atomic(const std::string& text, const std::string& path) {
+  write_via_temp(path, [&](TempFile& tmp) {
+    std::size_t done = 0;
+    while (done < text.size()) {
+      const ssize_t n = ::write(tmp.fd(), text.data() + done, text.size() - done);
+      if (n < 0 && errno == EINTR) continue;
+      if (n <= 0) tmp.fail(n < 0 ? errno : EIO);
+      done += std::size_t(n);
+    }
+  });
 }
 
 }  // namespace mcr

@@ -1,27 +1,33 @@
 #pragma once
-// Nothing is lost: every output is written to a hidden temp file in the target's
-// directory and renamed over the target only when complete.
+// Nothing is lost: every output is written to a hidden temp file of its own in the
+// target's directory and renamed over the target only when complete.
+//
+// Temp names: ".<name>.mcrecon-tmp.<pid>.<n><random>", created exclusively (O_EXCL),
+// the visible part cut so the whole fits NAME_MAX. Two runs writing one output each
+// write their own temp and rename it: both succeed, the last rename wins, and the
+// output is always one complete file (rename is atomic), never a mix.
 #include <string>
-#include <vector>
 
 #include <OpenImageIO/imagebuf.h>
 
+#include "io/output_guard.h"
+
 namespace mcr {
 
-// Throws InvalidArgument when output is one of the inputs, WriteFailed when its
-// directory is missing or not writable. Call before any expensive work.
-void check_output_path(const std::string& output, const std::vector<std::string>& inputs);
-// The same for every output of a sequence, in n log n rather than outputs x inputs.
-void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
+// Writes buf to path through a temp file + rename; format from the extension unless
+// given ("openexr", "png"); dtype: the file's pixel type (TypeUnknown: buf's).
+// Refuses a target that is not a regular file or a new path (check_output_target).
+// Removes the temps of earlier runs on this target whose process is gone.
+void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std::string& format = "",
+                  OIIO::TypeDesc dtype = OIIO::TypeUnknown);
 
-// Writes buf to path through a temp file + rename; format from the extension
-// unless given ("openexr", "png"). Removes stale temps of earlier killed runs.
-void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std::string& format = "");
+// The same for a text file (reports such as results.json).
+void write_text_atomic(const std::string& text, const std::string& path);
 
-// Async-signal-safe: unlinks the temp file being written, if any (for SIGINT/SIGTERM handlers).
+// Async-signal-safe: unlinks the temp files being written, if any (for signal handlers).
 void remove_pending_temp() noexcept;
 
-// The temp name used for path: "<dir>/.<name>.mcrecon-tmp.<pid>".
-std::string temp_path_for(const std::string& path);
+// The prefix every temp name for path starts with: ".<name, cut>.mcrecon-tmp.".
+std::string temp_prefix_for(const std::string& path);
 
 }  // namespace mcr

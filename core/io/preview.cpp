@@ -40,7 +40,7 @@ void write_side_by_side_png(const std::string& path, const std::vector<const Ima
   if (display.has_error())
     throw Error(Errc::InvalidArgument, "display transform " + options.display + "/" + options.view + " failed: " + display.geterror());
   display.set_write_format(TypeUInt8);
-  write_atomic(display, path, "png");
+  write_atomic(display, path, "png", TypeUInt8);
 }
 
 }  // namespace mcr

@@ -1,6 +1,5 @@
 #include "io/sequence.h"
 
-#include <cstdio>
 #include <regex>
 
 #include "util/error.h"
@@ -19,6 +18,13 @@ int to_int(const std::string& digits, const std::string& what) {
     throw Error(Errc::InvalidArgument, what + ": " + digits + " is out of range");
   }
 }
+// printf's "%0*d": the frame zero-padded to width digits (a sign counts), never cut.
+std::string padded(int frame, std::size_t width) {
+  const std::string digits = std::to_string(frame < 0 ? -(long long)frame : (long long)frame);
+  const std::size_t sign = frame < 0 ? 1 : 0;
+  const std::size_t zeros = width > digits.size() + sign ? width - digits.size() - sign : 0;
+  return (sign ? "-" : "") + std::string(zeros, '0') + digits;
+}
 }  // namespace
 
 bool is_sequence_pattern(const std::string& path) {
@@ -27,17 +33,11 @@ bool is_sequence_pattern(const std::string& path) {
 
 std::string sequence_path(const std::string& pattern, int frame) {
   std::smatch m;
-  if (std::regex_search(pattern, m, kHashes)) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%0*d", int(m.length(0)), frame);
-    return m.prefix().str() + buf + m.suffix().str();
-  }
+  if (std::regex_search(pattern, m, kHashes)) return m.prefix().str() + padded(frame, std::size_t(m.length(0))) + m.suffix().str();
   if (std::regex_search(pattern, m, kPrintf)) {
     const int width = m[1].length() ? to_int(m[1].str(), "frame pattern '" + pattern + "'") : 0;
     if (width > 16) throw Error(Errc::InvalidArgument, "frame pattern '" + pattern + "': width " + m[1].str() + " is too wide");
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%0*d", width, frame);
-    return m.prefix().str() + buf + m.suffix().str();
+    return m.prefix().str() + padded(frame, std::size_t(width)) + m.suffix().str();
   }
   return pattern;
 }

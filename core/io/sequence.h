@@ -11,7 +11,8 @@ struct FrameRange {
 };
 
 bool is_sequence_pattern(const std::string& path);
-// Substitutes the frame number (#### pads to the number of #, %0Nd as printf);
+// Substitutes the frame number in the first run (#### pads to the number of #, any
+// width; %0Nd as printf);
 // throws InvalidArgument for a %0Nd wider than 16 digits.
 std::string sequence_path(const std::string& pattern, int frame);
 // "1-16", "7" (one frame); throws InvalidArgument.

@@ -1,6 +1,9 @@
 #include "pipeline/denoise_session.h"
 
 #include <chrono>
+#include <filesystem>
+
+#include "io/output_guard.h"
 
 #include "util/error.h"
 
@@ -25,6 +28,16 @@ DenoiseSession::DenoiseSession(const std::string& filter,
 
 StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
                                const WriteOptions& write, const ExecOptions& exec) {
+  if (!output.empty()) {
+    // Every front end's file run passes here: the output is checked against every
+    // input of the run (the render and any loose pass file) before anything is read.
+    std::vector<std::string> inputs = {input};
+    for (const PassOverride& o : read.overrides) {
+      std::error_code ec;
+      if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
+    }
+    check_output_path(output, inputs);
+  }
   StageTimes t;
   auto t0 = std::chrono::steady_clock::now();
   Frame frame = read_frame(input, read);

@@ -30,7 +30,9 @@ class DenoiseSession {
   Reconstruction& reconstruction() { return reconstruction_; }
 
   // Reads input, filters, and writes output unless output is empty (warm-up of
-  // temporal history on frames that already have an output).
+  // temporal history on frames that already have an output). The output is checked
+  // first (io/output_guard.h): never an input of the run, only a regular file or a
+  // new path.
   StageTimes run(const std::string& input, const std::string& output, const ReadOptions& read,
                  const WriteOptions& write, const ExecOptions& exec);
 
