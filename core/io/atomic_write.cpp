@@ -47,8 +47,8 @@ int claim_slot(const std::string& p) {
   return -1;  // more writes in flight than slots: that temp is not removed on a signal
 }
 
-// ".mcrecon-tmp." + pid (10 digits at most) + "." + counter + "." + 8 hex digits.
-constexpr std::size_t kTailMax = 48;
+// ".mcrecon-tmp." (13) + pid (10 digits at most) + "." + counter (20) + "." + 8 hex digits.
+constexpr std::size_t kTailMax = 13 + 10 + 1 + 20 + 1 + 8;
 constexpr const char* kMarker = ".mcrecon-tmp.";
 
 // The visible part of a temp name: the target's name, cut (at a UTF-8 character
