@@ -6,8 +6,10 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
@@ -78,12 +80,14 @@ py::dict info_to_dict(const mcr::FilterInfo& info) {
 // same rules hold as for `mcrecon denoise --set`.
 std::string py_to_text(const std::string& key, const py::handle& v) {
   if (py::isinstance<py::bool_>(v)) return v.cast<bool>() ? "true" : "false";
-  if (py::isinstance<py::int_>(v)) return std::to_string(v.cast<long long>());
+  // Ints as their decimal text, any size: the table then reports an out-of-range value
+  // (a cast to long long would fail with a bare RuntimeError beyond 2^63).
+  if (py::isinstance<py::int_>(v)) return py::str(v).cast<std::string>();
   if (py::isinstance<py::float_>(v)) return py::str(py::repr(v)).cast<std::string>();  // round-trips
   if (py::isinstance<py::str>(v)) return v.cast<std::string>();
   if (py::hasattr(v, "dtype") && py::str(v.attr("dtype")).cast<std::string>() == "bool")  // numpy.bool_
     return py::bool_(py::reinterpret_borrow<py::object>(v)).cast<bool>() ? "true" : "false";
-  if (py::hasattr(v, "__index__")) return std::to_string(py::int_(py::reinterpret_borrow<py::object>(v)).cast<long long>());  // numpy ints
+  if (py::hasattr(v, "__index__")) return py::str(py::int_(py::reinterpret_borrow<py::object>(v))).cast<std::string>();  // numpy ints
   if (py::hasattr(v, "__float__"))  // numpy floats
     return py::str(py::repr(py::float_(py::reinterpret_borrow<py::object>(v)))).cast<std::string>();
   throw mcr::Error(Errc::BadParameterValue, "parameter '" + key + "': expected bool, int, float or str, got " +
@@ -133,7 +137,16 @@ mcr::ReadOptions read_options(const std::optional<std::string>& layer, const py:
 // One numpy pass (H x W or H x W x C) into the frame; checks size and channels.
 void add_array(mcr::Frame& frame, Role role, const py::object& obj, mcr::Space space) {
   if (obj.is_none()) return;
-  FloatArray a = FloatArray::ensure(obj);
+  // Its own dtype first: only real numbers are cast to float32 (float64, float16, ints,
+  // bools); a complex, object or string array would be cast by dropping or guessing.
+  const py::array given = py::array::ensure(obj);
+  if (!given) throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": expected a float array, got " +
+                                                          py::str(py::type::handle_of(obj).attr("__name__")).cast<std::string>());
+  const char kind = given.dtype().kind();
+  if (kind != 'f' && kind != 'i' && kind != 'u' && kind != 'b')
+    throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": expected a real float array, got " +
+                                                py::str(given.dtype().attr("name")).cast<std::string>());
+  FloatArray a = FloatArray::ensure(given);
   if (!a) throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": expected a float array");
   if (a.ndim() != 2 && a.ndim() != 3)
     throw mcr::Error(Errc::InvalidArgument, std::string(mcr::role_name(role)) + ": expected an H x W x C array, got " +
@@ -196,13 +209,53 @@ mcr::Frame frame_from_arrays(const ArrayPasses& a) {
   return f;
 }
 
-mcr::ExecOptions exec_options(int threads, const std::optional<std::vector<int>>& roi) {
+// roi: None or 4 ints (x0, y0, x1, y1), non-negative, x0 < x1 and y0 < y1; whether it
+// lies inside the image is the filter's check (Filter::execute).
+mcr::Roi roi_from_py(const py::object& roi) {
+  const std::string given = py::repr(roi).cast<std::string>();
+  const std::string form = ": expects (x0, y0, x1, y1) with 0 <= x0 < x1 and 0 <= y0 < y1";
+  std::vector<long long> v;
+  const bool sequence = py::isinstance<py::sequence>(roi) && !py::isinstance<py::str>(roi) && !py::isinstance<py::bytes>(roi);
+  if (sequence)
+    for (const py::handle item : roi) {
+      // Python and numpy ints (not bool, not float), within int.
+      const bool integer = !py::isinstance<py::bool_>(item) && !py::isinstance<py::float_>(item) &&
+                           py::hasattr(item, "__index__");
+      if (!integer) {
+        v.clear();
+        break;
+      }
+      const py::int_ i(py::reinterpret_borrow<py::object>(item));
+      if (i < py::int_(0) || i > py::int_(std::numeric_limits<int>::max()))
+        throw mcr::Error(Errc::InvalidArgument, "roi " + given + " has a coordinate outside [0, " +
+                                                    std::to_string(std::numeric_limits<int>::max()) + "]" + form);
+      v.push_back(i.cast<long long>());
+    }
+  if (v.size() != 4) throw mcr::Error(Errc::InvalidArgument, "roi " + given + " is not 4 ints" + form);
+  if (v[0] >= v[2] || v[1] >= v[3]) throw mcr::Error(Errc::InvalidArgument, "roi " + given + " is empty" + form);
+  return {int(v[0]), int(v[1]), int(v[2]), int(v[3])};
+}
+
+// A Python (or numpy) int within C++ int; anything else an mcrecon.Error naming the
+// argument and repeating what was given (pybind11's own int conversion raises a
+// TypeError that does neither).
+int int_from_py(const char* name, const py::handle& v) {
+  const bool integer = !py::isinstance<py::bool_>(v) && !py::isinstance<py::float_>(v) && py::hasattr(v, "__index__");
+  const std::string range = "[" + std::to_string(std::numeric_limits<int>::min()) + ", " +
+                            std::to_string(std::numeric_limits<int>::max()) + "]";
+  if (integer) {
+    const py::int_ i(py::reinterpret_borrow<py::object>(v));
+    if (i >= py::int_(std::numeric_limits<int>::min()) && i <= py::int_(std::numeric_limits<int>::max()))
+      return i.cast<int>();
+  }
+  throw mcr::Error(Errc::InvalidArgument, std::string(name) + " expects an int in " + range + ", got " +
+                                              py::repr(v).cast<std::string>());
+}
+
+mcr::ExecOptions exec_options(int threads, const py::object& roi) {
   mcr::ExecOptions eo;
   eo.nthreads = threads;
-  if (roi) {
-    if (roi->size() != 4) throw mcr::Error(Errc::InvalidArgument, "roi must be (x0, y0, x1, y1)");
-    eo.roi = {(*roi)[0], (*roi)[1], (*roi)[2], (*roi)[3]};
-  }
+  if (!roi.is_none()) eo.roi = roi_from_py(roi);
   return eo;
 }
 
@@ -243,7 +296,8 @@ py::dict times_dict(const mcr::StageTimes& t) {
 // ------------------------------------------------------------------ Session
 
 // One reconstruction (optional accumulation stage + a filter committed once), with
-// its temporal history kept across calls.
+// its temporal history kept across calls. Shared by several Python threads, its calls
+// run one at a time (mcr::Reconstruction's lock); frame order is the caller's.
 class Session {
  public:
   Session(const std::string& filter, const py::dict& params, int threads, const py::handle& accumulate)
@@ -258,10 +312,19 @@ class Session {
     return d;
   }
   py::dict needs() { return needs_dict(session_.reconstruction().needs()); }
-  std::vector<std::string> notes() { return session_.reconstruction().notes(); }
-  void reset() { session_.reconstruction().reset(); }
+  // The reconstruction serialises its calls (a mutex held across run, reset and notes):
+  // every call that may wait on it releases the GIL first, so a thread waiting for the
+  // session never blocks the one that holds it.
+  std::vector<std::string> notes() {
+    py::gil_scoped_release release;
+    return session_.reconstruction().notes();
+  }
+  void reset() {
+    py::gil_scoped_release release;
+    session_.reconstruction().reset();
+  }
 
-  py::array_t<float> denoise(const ArrayPasses& a, const std::optional<std::vector<int>>& roi) {
+  py::array_t<float> denoise(const ArrayPasses& a, const py::object& roi) {
     const mcr::Frame frame = frame_from_arrays(a);
     const mcr::ExecOptions eo = exec_options(threads_, roi);
     mcr::Image out;
@@ -279,7 +342,7 @@ class Session {
     wo.keep_passes = keep_passes;
     mcr::ReadOptions r = ro;
     r.keep_extra = keep_passes;
-    const mcr::ExecOptions eo = exec_options(threads_, std::nullopt);
+    const mcr::ExecOptions eo = exec_options(threads_, py::none());
     mcr::StageTimes t;
     {
       py::gil_scoped_release release;
@@ -293,9 +356,9 @@ class Session {
   int threads_;
 };
 
-void raise_error(const mcr::Error& e) {
-  py::object exc = py::reinterpret_borrow<py::object>(g_error_type)(py::str(e.what()));
-  exc.attr("kind") = mcr::errc_name(e.code());
+void raise_error(Errc code, const std::string& message) {
+  py::object exc = py::reinterpret_borrow<py::object>(g_error_type)(py::str(message));
+  exc.attr("kind") = mcr::errc_name(code);
   PyErr_SetObject(g_error_type, exc.ptr());
 }
 
@@ -314,11 +377,24 @@ PYBIND11_MODULE(mcrecon, m) {
   g_error_type = PyErr_NewException("mcrecon.Error", PyExc_RuntimeError, error_ns.ptr());
   if (!g_error_type) throw py::error_already_set();
   m.attr("Error") = py::reinterpret_borrow<py::object>(g_error_type);
+  // Every C++ exception leaves as mcrecon.Error, never a bare RuntimeError: a Python error
+  // already set (a progress callback's), a TypeError or ValueError pybind11 raises itself,
+  // and MemoryError keep their own type.
   py::register_exception_translator([](std::exception_ptr p) {
     try {
       if (p) std::rethrow_exception(p);
     } catch (const mcr::Error& e) {
-      raise_error(e);
+      raise_error(e.code(), e.what());
+    } catch (const py::cast_error& e) {  // a value pybind11 could not convert
+      raise_error(Errc::InvalidArgument, std::string("cannot convert a value: ") + e.what());
+    } catch (const py::error_already_set&) {
+      throw;
+    } catch (const py::builtin_exception&) {
+      throw;
+    } catch (const std::bad_alloc&) {
+      throw;
+    } catch (const std::exception& e) {
+      raise_error(Errc::Internal, e.what());
     }
   });
 
@@ -352,7 +428,7 @@ PYBIND11_MODULE(mcrecon, m) {
           "denoise",
           [](Session& s, py::object colour, py::object albedo, py::object normal, py::object position, py::object depth,
              py::object motion, py::object variance, py::object sample_count, py::object alpha,
-             const std::string& normal_space, const std::optional<std::vector<int>>& roi) {
+             const std::string& normal_space, const py::object& roi) {
             return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
                              roi);
           },
@@ -370,7 +446,7 @@ PYBIND11_MODULE(mcrecon, m) {
       "denoise",
       [](const std::string& filter, py::object colour, py::object albedo, py::object normal, py::object position,
          py::object depth, py::object motion, py::object variance, py::object sample_count, py::object alpha,
-         const std::string& normal_space, const py::dict& params, int threads, const std::optional<std::vector<int>>& roi,
+         const std::string& normal_space, const py::dict& params, int threads, const py::object& roi,
          const py::object& accumulate) {
         Session s(filter, params, threads, accumulate);
         return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
@@ -399,17 +475,19 @@ PYBIND11_MODULE(mcrecon, m) {
 
   m.def(
       "denoise_sequence",
-      [](const std::string& input, const std::string& output, int first, int last, const std::string& filter,
+      [](const std::string& input, const std::string& output, const py::object& first_arg, const py::object& last_arg,
+         const std::string& filter,
          const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
-         const std::optional<std::function<void(int, int, std::string)>>& progress, const py::object& accumulate) {
+         const std::optional<std::function<void(std::int64_t, std::int64_t, std::string)>>& progress, const py::object& accumulate) {
+        const int first = int_from_py("first", first_arg), last = int_from_py("last", last_arg);
         if (!mcr::is_sequence_pattern(input) || !mcr::is_sequence_pattern(output))
           throw mcr::Error(Errc::InvalidArgument, "input and output must be sequence patterns (#### or %04d)");
         if (last < first) throw mcr::Error(Errc::InvalidArgument, "frame range " + std::to_string(first) + "-" +
                                                                         std::to_string(last) + " is empty");
         // Every input, and every output against them all, checked before the first frame is
-        // filtered (as the CLI does); long long: a range ending at INT_MAX ends.
+        // filtered (as the CLI does); 64-bit counters: a range ending at INT_MAX ends.
         std::vector<std::string> inputs;
-        for (long long f = first; f <= last; ++f) {
+        for (std::int64_t f = first; f <= last; ++f) {
           inputs.push_back(mcr::sequence_path(input, int(f)));
           std::error_code ec;
           if (!std::filesystem::exists(inputs.back(), ec))
@@ -422,11 +500,11 @@ PYBIND11_MODULE(mcrecon, m) {
         mcr::check_sequence_outputs(output, {first, last}, inputs);
         Session s(filter, params, threads, accumulate);
         py::list outputs;
-        for (long long f = first; f <= last; ++f) {
+        for (std::int64_t f = first; f <= last; ++f) {
           const std::string out = mcr::sequence_path(output, int(f));
           s.denoise_file(inputs[std::size_t(f - first)], out, layer, passes, false);
           outputs.append(out);
-          if (progress) (*progress)(int(f - first + 1), int((long long)last - first + 1), out);
+          if (progress) (*progress)(f - first + 1, std::int64_t(last) - first + 1, out);
         }
         return outputs;
       },

@@ -37,6 +37,7 @@ PassNeeds Reconstruction::needs() const {
 
 Image Reconstruction::run(const Frame& frame, const ExecOptions& options) {
   if (!accumulate_) {
+    const std::lock_guard<std::mutex> lock(mutex_);
     notes_.clear();
     return filter_->execute(frame, options);
   }
@@ -45,6 +46,7 @@ Image Reconstruction::run(const Frame& frame, const ExecOptions& options) {
 }
 
 Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options) {
+  const std::lock_guard<std::mutex> lock(mutex_);
   notes_.clear();
   if (!accumulate_) return filter_->execute(frame, options);
   // Accumulation's passes first: nothing is accumulated for a frame the filter refuses.
@@ -60,11 +62,13 @@ Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options) {
 }
 
 void Reconstruction::reset() {
+  const std::lock_guard<std::mutex> lock(mutex_);
   accumulator_.reset();
   filter_->reset();
 }
 
 std::vector<std::string> Reconstruction::notes() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
   std::vector<std::string> all = filter_->unused_settings();
   all.insert(all.end(), filter_->notes().begin(), filter_->notes().end());
   all.insert(all.end(), notes_.begin(), notes_.end());

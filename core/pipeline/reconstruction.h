@@ -5,7 +5,14 @@
 // history across the frames of a run) before the filter, which then sees a frame whose
 // colour pass holds the accumulated RGB (alpha and other channels kept). Only the
 // pipeline combines stages; the filter knows nothing of it.
+//
+// Shared use: run(), run_in_place(), reset() and notes() may be called from several
+// threads at once; they are serialised (a mutex held for the whole call), in the order
+// the calls take the lock. A temporal session's frame order is then the caller's
+// responsibility. filter() gives the filter itself, outside that lock: use it to read
+// its table and settings, not to execute it.
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -36,7 +43,8 @@ class Reconstruction {
   // Drops the history of both stages (new shot, frames out of order).
   void reset();
 
-  // The unused settings, then the notes of the last run() (the filter's, the accumulation's).
+  // The unused settings, then the notes of the last run() (the filter's, the accumulation's):
+  // a copy, taken under the lock.
   std::vector<std::string> notes() const;
   // "accumulate=true radius=3 ...": every setting, as the mcreconParameters attribute.
   std::string parameters_text() const;
@@ -46,6 +54,9 @@ class Reconstruction {
   bool accumulate_ = false;
   TemporalAccumulator accumulator_;
   std::vector<std::string> notes_;
+  // Held across every call that reads or changes the filter's per-run state (its prepared
+  // buffers and notes) or the accumulation history: one frame at a time.
+  mutable std::mutex mutex_;
 };
 
 // The filter made, every key=value set (from its table) and committed: all parameter

@@ -3,15 +3,27 @@
 // colour is divided by the albedo so a filter smooths the illumination, not the
 // texture, and multiplied back after. One rule for every user:
 //   a = max(albedo, floor) where the albedo is finite, 1 where it is not;
+//   a = max(a, |colour| * 2^-126) where the colour is finite;
 // no upper clamp (Blender's Denoising Albedo exceeds 1 on highlights, >100 near
-// lights), and dividing and multiplying by the same value is exact.
+// lights), and dividing and multiplying by the same value is exact. The second line keeps
+// colour / a within 2^126, so a finite colour near FLT_MAX over a dark albedo does not
+// overflow to inf (and come back as 0); it never acts below |colour| = 2^126 * a (8.5e37 a),
+// so ordinary images are divided by the albedo as they always were.
 #include <algorithm>
+#include <cmath>
 
 #include "image/image.h"
 
 namespace mcr {
 
 inline float demodulation_albedo(float v, float floor) { return (v - v == 0.0f) ? std::max(v, floor) : 1.0f; }
+
+// The divisor of one colour value c over albedo v (the rule above). 2^-126 is FLT_MIN, a
+// normal float (no flush-to-zero concern), and |c| * 2^-126 is exact where it matters.
+inline float demodulation_divisor(float v, float c, float floor) {
+  const float need = (c - c == 0.0f) ? std::fabs(c) * 0x1p-126f : 0.0f;
+  return std::max(demodulation_albedo(v, floor), need);
+}
 
 // One row of n pixels: al = the divisor per channel (an albedo of fewer than 3 channels
 // repeats its last one), il = colour / al. colour, al and il are RGB.
