@@ -51,8 +51,8 @@ def front_end_missing(fe):
         if not os.path.exists(os.path.join(plugin_dir(), "mcrecon.imageio.so")):
             return "no mcrecon.imageio.so in %s" % plugin_dir()
         return None if os.access(OIIOTOOL, os.X_OK) else "no oiiotool"
-    if not any(n.startswith("mcrecon.") and n.endswith(".so") for n in os.listdir(python_dir())
-               if os.path.isdir(python_dir())):
+    names = os.listdir(python_dir()) if os.path.isdir(python_dir()) else []
+    if not any(n.startswith("mcrecon.") and n.endswith(".so") for n in names):
         return "no mcrecon Python module in %s" % python_dir()
     return None
 
