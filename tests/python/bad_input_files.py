@@ -198,3 +198,22 @@ def read_rgba(path):
         return spec.width, spec.height, px[..., [names.index(c) for c in "RGBA"]]
     finally:
         inp.close()
+
+
+def claim_size_with_table(src, dst, width, height, lines_per_chunk=16):
+    """Like claim_size, but with a complete chunk offset table for the claimed height (every entry
+    pointing at the file's one real chunk): the reader gets past the table, so a front end that
+    sizes its buffers by the header allocates the whole claimed image before the read fails."""
+    data = bytearray(open(src, "rb").read())
+    attrs, table = header_attributes(data)
+    compression = [data[off] for name, typ, off, size in attrs if name == "compression"][0]
+    assert compression == 3, "needs a ZIP-compressed source (16 lines per chunk)"
+    n_old = (H + lines_per_chunk - 1) // lines_per_chunk
+    chunks = bytes(data[table + 8 * n_old:])
+    header = bytearray(data[:table])
+    for name, typ, off, size in attrs:
+        if name in ("dataWindow", "displayWindow"):
+            struct.pack_into("<iiii", header, off, 0, 0, width - 1, height - 1)
+    n_new = (height + lines_per_chunk - 1) // lines_per_chunk
+    first = len(header) + 8 * n_new
+    open(dst, "wb").write(bytes(header) + struct.pack("<%dQ" % n_new, *([first] * n_new)) + chunks)

@@ -18,6 +18,7 @@ missing is skipped. MATRIX_CASES=name,name runs only those cases.
 import json
 import os
 import re
+import resource
 import shutil
 import subprocess
 import sys
@@ -32,6 +33,10 @@ import bad_input_files as bf  # noqa: E402
 import mcrecon_testutil as tu  # noqa: E402
 
 TIMEOUT = 10
+# Peak memory of any one run: every input is 16x12, so more means an allocation sized by a header
+# (or a count) that the file cannot justify. Measured as the children's peak RSS, which only says
+# something when it rises above what earlier runs reached.
+PEAK_LIMIT_MB = 512
 OIIOTOOL = shutil.which("oiiotool") or "/usr/bin/oiiotool"
 PYTHON = "/usr/bin/python3"
 
@@ -78,6 +83,7 @@ class Outcome:
 
     def __init__(self, fe, cmd):
         self.fe, self.cmd, self.ok, self.message, self.problem, self.log = fe, cmd, False, "", None, ""
+        self.wrong_kind = None  # a refusal of the wrong kind (CLI status, Python exception type)
 
 
 def run_front_end(fe, spec, c):
@@ -93,13 +99,28 @@ def run_front_end(fe, spec, c):
         shown = "oiiotool " + " ".join(spec)
     o = Outcome(fe, shown)
     env = dict(os.environ, OIIO_LIBRARY_PATH=plugin_dir())
+    peak_before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss // 1024
+    try:
+        return _run(fe, cmd, c, env, o)
+    finally:
+        peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss // 1024
+        if peak > max(peak_before, PEAK_LIMIT_MB):
+            o.problem = "peak memory %d MB for 16x12 inputs (limit %d MB)%s" % (
+                peak, PEAK_LIMIT_MB, "; " + o.problem if o.problem else "")
+
+
+def _text(out):
+    """Partial output of a killed run (bytes even in text mode)."""
+    return out.decode(errors="replace") if isinstance(out, bytes) else (out or "")
+
+
+def _run(fe, cmd, c, env, o):
     try:
         p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT, cwd=c.d, env=env,
                            stdin=subprocess.DEVNULL)
     except subprocess.TimeoutExpired as e:
         o.problem = "no answer within %d s (hang; killed)" % TIMEOUT
-        o.log = ((e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")) + \
-                ((e.stderr or b"").decode(errors="replace") if isinstance(e.stderr, bytes) else (e.stderr or ""))
+        o.log = _text(e.stdout) + _text(e.stderr)
         return o
     o.log = p.stdout + p.stderr
     if p.returncode < 0:
@@ -111,18 +132,17 @@ def run_front_end(fe, spec, c):
             o.problem = "the interpreter exited %d without a result" % p.returncode
             return o
         r = json.loads(lines[-1][len("@@RESULT "):])
-        o.ok, o.message = r["ok"], r.get("message", "")
+        o.ok, o.message, o.exc_type = r["ok"], r.get("message", ""), r.get("type")
         if not r["ok"] and not (r["is_mcrecon_error"] and r["kind"]):
-            o.problem = "raised %s (kind %r), want mcrecon.Error with a .kind: %s" % (r["type"], r["kind"], o.message)
-        o.exc = r
+            o.wrong_kind = "raised %s (kind %r), want mcrecon.Error with a .kind" % (r["type"], r["kind"])
         return o
     o.ok = p.returncode == 0
     o.message = o.log
     if fe.startswith("cli") and not o.ok:
         if p.returncode != 2:
-            o.problem = "exit status %d, want 2" % p.returncode
+            o.wrong_kind = "exit status %d, want 2" % p.returncode
         elif "mcrecon: error:" not in o.log or "internal error" in o.log:
-            o.problem = "no 'mcrecon: error:' line (or an internal error)"
+            o.wrong_kind = "no 'mcrecon: error:' line (or an internal error)"
     return o
 
 
@@ -166,6 +186,7 @@ class BadInputMatrix(unittest.TestCase):
 
     def check_refusal(self, mentions, o, before, after, head, tail):
         self.assertFalse(o.ok, head + "succeeded, want a refusal naming %s" % (mentions,) + tail)
+        self.assertIsNone(o.wrong_kind, head + "%s: %s" % (o.wrong_kind, o.message.strip()[-2000:]))
         missing = missing_mentions(o.message, mentions)
         self.assertFalse(missing, head + "the message does not name %s: %s" % (", ".join(missing), o.message.strip()))
         self.assertIsNone(re.search(r"\d{25}", o.message),
@@ -175,7 +196,8 @@ class BadInputMatrix(unittest.TestCase):
                                     "output, no temp file):\n" + diff + tail)
 
     def check_success(self, case, fe, c, o, before, after, head, tail):
-        self.assertTrue(o.ok, head + "failed, want success:\n" + o.message.strip()[-3000:])
+        self.assertTrue(o.ok, head + "failed, want success:\n" + o.message.strip()[-3000:] +
+                        ("\n(%s)" % o.exc_type if getattr(o, "exc_type", None) else ""))
         kept = {p: k for p, k in before.items() if p not in case.mutable}
         diff = bf.snapshot_diff(kept, {p: after[p] for p in kept if p in after})
         self.assertEqual(diff, "", head + "an input changed:\n" + diff)
@@ -185,7 +207,10 @@ class BadInputMatrix(unittest.TestCase):
         self.assertEqual(bf.temp_files(c.d), [], head + "a temp file is left")
         for name in case.outputs:
             path = c.p(name)
-            w, h, px = bf.read_rgba(path)
+            try:
+                w, h, px = bf.read_rgba(path)
+            except AssertionError as e:
+                self.fail(head + "output %s is not a complete image: %s" % (name, e))
             self.assertEqual((w, h), case.size, head + "%s is %dx%d, want %dx%d" % (name, w, h, *case.size))
             bad = int(np.count_nonzero(~np.isfinite(px)))
             self.assertEqual(bad, 0, head + "%s holds %d non-finite values" % (name, bad))
