@@ -75,15 +75,15 @@ def output_fe(out, oiio=True):
     return fe
 
 
-def param_fe(query, typed, py_params):
+def param_fe(query, typed, py_params, filt="box"):
     """A filter parameter through every front end: --set, ?query, --iconfig (typed), params=."""
     key, value = query.split("=", 1)
-    return dict(cli=cli_denoise("{inp}", "{out}", "--set", query),
-                oiio_read=oiio_read("{inp}", "filter=box&" + query),
-                oiio_iconfig=lambda c: ["--iconfig", "mcrecon:filter", "box",
+    return dict(cli=cli_denoise("{inp}", "{out}", "--set", query, filt=filt),
+                oiio_read=oiio_read("{inp}", "filter=%s&%s" % (filt, query)),
+                oiio_iconfig=lambda c: ["--iconfig", "mcrecon:filter", filt,
                                         *(["--iconfig:type=" + typed] if typed else ["--iconfig"]),
                                         "mcrecon:" + key, value, c.inp + ".mcrecon", "-o", c.out],
-                py=lambda c: "mcrecon.denoise_file(%r, %r, 'box', %s)" % (c.inp, c.out, py_params))
+                py=lambda c: "mcrecon.denoise_file(%r, %r, %r, %s)" % (c.inp, c.out, filt, py_params))
 
 
 # ---------------------------------------------------------------------- builders
@@ -268,6 +268,11 @@ def _cases():
     add("out_of_range_1e20", param_fe("radius=1e20", "float", "{'radius': 1e20}"),
         mentions=["radius", ("1e20", "1e+20")], note="echoed as 1e+20; bare RuntimeError in Python (issue 9)",
         mentions_fe={"cli": ["radius", "1e20"], "oiio_read": ["radius", "1e20"]})  # as typed
+    add("out_of_range_float_1e20", param_fe("spatial_sigma=1e20", "float", "{'spatial_sigma': 1e20}", "bilateral"),
+        mentions=["spatial_sigma", ("1e20", "1e+20")], note="echoed as 1e+20 (issue 9)",
+        mentions_fe={"cli": ["spatial_sigma", "1e20"], "oiio_read": ["spatial_sigma", "1e20"]})
+    add("py_parameter_int_beyond_int64", dict(py=lambda c: "mcrecon.Session('box', {'radius': 10**30})"),
+        mentions=["radius"], note="bare RuntimeError 'Unable to cast Python instance' (issue 9)")
     add("non_numeric_parameter", param_fe("radius=abc", "", "{'radius': 'abc'}"), mentions=["radius", "abc"])
     add("nan_parameter", param_fe("radius=nan", "", "{'radius': float('nan')}"), mentions=["radius", "nan"])
     add("compression_bogus",
