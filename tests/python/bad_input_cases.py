@@ -90,7 +90,7 @@ def param_fe(query, typed, py_params, filt="box"):
 
 def b_cut(n):
     def build(c):
-        bf.cut(c.inp, c.p("cut.exr"), n(open(c.inp, "rb").read()))
+        bf.cut(c.inp, c.p("cut.exr"), n(bf.read_bytes(c.inp)))
     return build
 
 
@@ -154,9 +154,9 @@ def b_multipart(c):
 def b_resume(c):
     b_seq(c)
     bf.write_render(c.p("full.exr"), seed=9, w=bf.W, h=bf.H)
-    data = open(c.p("full.exr"), "rb").read()
+    data = bf.read_bytes(c.p("full.exr"))
     os.remove(c.p("full.exr"))
-    open(c.p("out_0001.exr"), "wb").write(data[:len(data) // 2])
+    bf.write_bytes(c.p("out_0001.exr"), data[:len(data) // 2])
 
 
 def b_demo(c):
@@ -179,10 +179,10 @@ def _cases():
     add("missing_file", input_fe("{d}/nosuch.exr"), mentions=["nosuch.exr"])
     add("directory_input", input_fe("{d}/adir.exr"), build=lambda c: os.mkdir(c.p("adir.exr")),
         mentions=["adir.exr"])
-    add("empty_file", input_fe("{d}/empty.exr"), build=lambda c: open(c.p("empty.exr"), "wb").close(),
+    add("empty_file", input_fe("{d}/empty.exr"), build=lambda c: bf.write_bytes(c.p("empty.exr"), b""),
         mentions=["empty.exr"])
     add("text_named_exr", input_fe("{d}/notes.exr"),
-        build=lambda c: open(c.p("notes.exr"), "w").write("this is not an image\n" * 20), mentions=["notes.exr"])
+        build=lambda c: bf.write_bytes(c.p("notes.exr"), b"this is not an image\n" * 20), mentions=["notes.exr"])
     header_end = lambda data: bf.header_attributes(data)[1] + 4  # inside the offset table
     for label, n in (("cut_8", lambda data: 8), ("cut_100", lambda data: 100), ("cut_in_offset_table", header_end),
                      ("cut_half", lambda data: len(data) // 2), ("cut_last_byte", lambda data: len(data) - 1)):

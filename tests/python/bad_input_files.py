@@ -40,6 +40,16 @@ def blender_pixels(seed=0, w=W, h=H):
     return px
 
 
+def read_bytes(path):
+    with open(path, "rb") as f:
+        return f.read()
+
+
+def write_bytes(path, data):
+    with open(path, "wb") as f:
+        f.write(data)
+
+
 def write_exr(path, pixels, names, compression="zip", origin=(0, 0)):
     pixels = np.ascontiguousarray(pixels, dtype=np.float32)
     h, w, c = pixels.shape
@@ -100,26 +110,26 @@ def header_attributes(data):
 def claim_size(src, dst, width, height):
     """Copies the EXR src to dst with its data and display windows patched to width x height:
     a tiny file whose header claims a huge image."""
-    data = bytearray(open(src, "rb").read())
+    data = bytearray(read_bytes(src))
     attrs, _ = header_attributes(data)
     for name, typ, off, size in attrs:
         if name in ("dataWindow", "displayWindow"):
             assert typ == "box2i" and size == 16
             struct.pack_into("<iiii", data, off, 0, 0, width - 1, height - 1)
-    open(dst, "wb").write(bytes(data))
+    write_bytes(dst, bytes(data))
 
 
 def flip_offset_table(src, dst):
     """Copies src to dst with one bit flipped in the high bytes of the first chunk offset: the
     offset then points far beyond the end of the file."""
-    data = bytearray(open(src, "rb").read())
+    data = bytearray(read_bytes(src))
     _, table = header_attributes(data)
     data[table + 5] ^= 0x40
-    open(dst, "wb").write(bytes(data))
+    write_bytes(dst, bytes(data))
 
 
 def cut(src, dst, n):
-    open(dst, "wb").write(open(src, "rb").read()[:n])
+    write_bytes(dst, read_bytes(src)[:n])
 
 
 def mknod_char(path, major, minor):
@@ -204,7 +214,7 @@ def claim_size_with_table(src, dst, width, height, lines_per_chunk=16):
     """Like claim_size, but with a complete chunk offset table for the claimed height (every entry
     pointing at the file's one real chunk): the reader gets past the table, so a front end that
     sizes its buffers by the header allocates the whole claimed image before the read fails."""
-    data = bytearray(open(src, "rb").read())
+    data = bytearray(read_bytes(src))
     attrs, table = header_attributes(data)
     compression = [data[off] for name, typ, off, size in attrs if name == "compression"][0]
     assert compression == 3, "needs a ZIP-compressed source (16 lines per chunk)"
@@ -216,4 +226,4 @@ def claim_size_with_table(src, dst, width, height, lines_per_chunk=16):
             struct.pack_into("<iiii", header, off, 0, 0, width - 1, height - 1)
     n_new = (height + lines_per_chunk - 1) // lines_per_chunk
     first = len(header) + 8 * n_new
-    open(dst, "wb").write(bytes(header) + struct.pack("<%dQ" % n_new, *([first] * n_new)) + chunks)
+    write_bytes(dst, bytes(header) + struct.pack("<%dQ" % n_new, *([first] * n_new)) + chunks)

@@ -18,12 +18,13 @@ missing is skipped. MATRIX_CASES=name,name runs only those cases.
 import json
 import os
 import re
-import resource
+import threading
 import shutil
 import subprocess
 import sys
 import tempfile
 import unittest
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -33,9 +34,8 @@ import bad_input_files as bf  # noqa: E402
 import mcrecon_testutil as tu  # noqa: E402
 
 TIMEOUT = 10
-# Peak memory of any one run: every input is 16x12, so more means an allocation sized by a header
-# (or a count) that the file cannot justify. Measured as the children's peak RSS, which only says
-# something when it rises above what earlier runs reached.
+# Peak memory of one run: every input is 16x12, so more means an allocation sized by a header (or
+# a count) that the file cannot justify.
 PEAK_LIMIT_MB = 512
 OIIOTOOL = shutil.which("oiiotool") or "/usr/bin/oiiotool"
 PYTHON = "/usr/bin/python3"
@@ -99,48 +99,54 @@ def run_front_end(fe, spec, c):
         shown = "oiiotool " + " ".join(spec)
     o = Outcome(fe, shown)
     env = dict(os.environ, OIIO_LIBRARY_PATH=plugin_dir())
-    peak_before = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss // 1024
-    try:
-        return _run(fe, cmd, c, env, o)
-    finally:
-        peak = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss // 1024
-        if peak > max(peak_before, PEAK_LIMIT_MB):
-            o.problem = "peak memory %d MB for 16x12 inputs (limit %d MB)%s" % (
-                peak, PEAK_LIMIT_MB, "; " + o.problem if o.problem else "")
-
-
-def _text(out):
-    """Partial output of a killed run (bytes even in text mode)."""
-    return out.decode(errors="replace") if isinstance(out, bytes) else (out or "")
-
-
-def _run(fe, cmd, c, env, o):
-    try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=TIMEOUT, cwd=c.d, env=env,
-                           stdin=subprocess.DEVNULL)
-    except subprocess.TimeoutExpired as e:
-        o.problem = "no answer within %d s (hang; killed)" % TIMEOUT
-        o.log = _text(e.stdout) + _text(e.stderr)
+    returncode, o.log, peak_mb, killed = spawn(cmd, c.d, env)
+    problems = []
+    if killed:
+        problems.append("no answer within %d s (hang; killed)" % TIMEOUT)
+    elif returncode < 0:
+        problems.append("killed by signal %d (crash)" % -returncode)
+    if peak_mb > PEAK_LIMIT_MB:
+        problems.append("peak memory %d MB for 16x12 inputs (limit %d MB)" % (peak_mb, PEAK_LIMIT_MB))
+    if problems:
+        o.problem = "; ".join(problems)
         return o
-    o.log = p.stdout + p.stderr
-    if p.returncode < 0:
-        o.problem = "killed by signal %d (crash)" % -p.returncode
-        return o
+    return _judge(fe, returncode, o)
+
+
+def spawn(cmd, cwd, env):
+    """Runs cmd; returns (exit code, stdout + stderr, peak RSS in MB, killed after TIMEOUT s).
+    os.wait4 gives this process's own peak memory, whatever runs beside it."""
+    with tempfile.TemporaryFile() as out:
+        p = subprocess.Popen(cmd, stdout=out, stderr=subprocess.STDOUT, stdin=subprocess.DEVNULL,
+                             cwd=cwd, env=env)
+        killed = []
+        timer = threading.Timer(TIMEOUT, lambda: (killed.append(True), p.kill()))
+        timer.start()
+        try:
+            _, status, usage = os.wait4(p.pid, 0)
+        finally:
+            timer.cancel()
+        p.returncode = os.waitstatus_to_exitcode(status)
+        out.seek(0)
+        return p.returncode, out.read().decode(errors="replace"), usage.ru_maxrss // 1024, bool(killed)
+
+
+def _judge(fe, returncode, o):
     if fe.startswith("py"):
-        lines = [l for l in p.stdout.splitlines() if l.startswith("@@RESULT ")]
-        if p.returncode != 0 or not lines:
-            o.problem = "the interpreter exited %d without a result" % p.returncode
+        lines = [l for l in o.log.splitlines() if l.startswith("@@RESULT ")]
+        if returncode != 0 or not lines:
+            o.problem = "the interpreter exited %d without a result" % returncode
             return o
         r = json.loads(lines[-1][len("@@RESULT "):])
         o.ok, o.message, o.exc_type = r["ok"], r.get("message", ""), r.get("type")
         if not r["ok"] and not (r["is_mcrecon_error"] and r["kind"]):
             o.wrong_kind = "raised %s (kind %r), want mcrecon.Error with a .kind" % (r["type"], r["kind"])
         return o
-    o.ok = p.returncode == 0
+    o.ok = returncode == 0
     o.message = o.log
     if fe.startswith("cli") and not o.ok:
-        if p.returncode != 2:
-            o.wrong_kind = "exit status %d, want 2" % p.returncode
+        if returncode != 2:
+            o.wrong_kind = "exit status %d, want 2" % returncode
         elif "mcrecon: error:" not in o.log or "internal error" in o.log:
             o.wrong_kind = "no 'mcrecon: error:' line (or an internal error)"
     return o
@@ -155,26 +161,59 @@ def missing_mentions(message, mentions):
     return missing
 
 
+class Run:
+    """One (case, front end) executed in its own directory: the snapshots around the run."""
+
+    def __init__(self, case, fe):
+        self.case, self.fe, self.skip, self.outcome, self.c = case, fe, front_end_missing(fe), None, None
+        if self.skip:
+            return
+        self.root = tempfile.mkdtemp(prefix="mcrecon_matrix_")
+        d = os.path.join(self.root, "case")
+        os.mkdir(d)
+        self.c = bc.ctx(d)
+        self.c.root = self.root
+        try:
+            case.build(self.c)
+        except bc.Skip as e:
+            self.skip = str(e)
+            return
+        self.before = bf.snapshot(d)
+        self.outcome = run_front_end(fe, case.fe[fe](self.c), self.c)
+        self.after = bf.snapshot(d)
+
+    def cleanup(self):
+        if self.c is not None:
+            bc.cleanup(self.c)
+            shutil.rmtree(self.root, ignore_errors=True)
+
+
+_RUNS = {}
+
+
+def selected():
+    only = set(filter(None, os.environ.get("MATRIX_CASES", "").split(",")))
+    return [(case, fe) for case in bc.CASES if not only or case.name in only for fe in case.fe]
+
+
+def run_all():
+    """Every selected (case, front end), two at a time (each run is one process, mostly start-up)."""
+    if not _RUNS:
+        with ThreadPoolExecutor(max_workers=2) as pool:
+            for (case, fe), run in zip(selected(), pool.map(lambda k: Run(*k), selected())):
+                _RUNS[case.name, fe] = run
+    return _RUNS
+
+
 class BadInputMatrix(unittest.TestCase):
     maxDiff = None
 
     def run_case(self, case, fe):
-        why = front_end_missing(fe)
-        if why:
-            self.skipTest(why)
-        root = tempfile.mkdtemp(prefix="mcrecon_matrix_")
-        d = os.path.join(root, "case")
-        os.mkdir(d)
-        c = bc.ctx(d)
-        c.root = root
-        self.addCleanup(lambda: (bc.cleanup(c), shutil.rmtree(root, ignore_errors=True)))
-        try:
-            case.build(c)
-        except bc.Skip as e:
-            self.skipTest(str(e))
-        before = bf.snapshot(d)
-        o = run_front_end(fe, case.fe[fe](c), c)
-        after = bf.snapshot(d)
+        run = run_all()[case.name, fe]
+        self.addCleanup(run.cleanup)
+        if run.skip:
+            self.skipTest(run.skip)
+        c, o, before, after = run.c, run.outcome, run.before, run.after
         head = "%s [%s]: %s\n" % (case.name, fe, o.cmd)
         tail = "\n--- output ---\n%s" % o.log[-3000:]
         if o.problem:
@@ -236,15 +275,11 @@ class BadInputMatrix(unittest.TestCase):
 
 
 def _add_tests():
-    only = set(filter(None, os.environ.get("MATRIX_CASES", "").split(",")))
-    for case in bc.CASES:
-        if only and case.name not in only:
-            continue
-        for fe in case.fe:
-            def test(self, case=case, fe=fe):
-                self.run_case(case, fe)
-            test.__doc__ = "%s through %s%s" % (case.name, fe, " (%s)" % case.note if case.note else "")
-            setattr(BadInputMatrix, "test_%s__%s" % (case.name, fe), test)
+    for case, fe in selected():
+        def test(self, case=case, fe=fe):
+            self.run_case(case, fe)
+        test.__doc__ = "%s through %s%s" % (case.name, fe, " (%s)" % case.note if case.note else "")
+        setattr(BadInputMatrix, "test_%s__%s" % (case.name, fe), test)
 
 
 _add_tests()
