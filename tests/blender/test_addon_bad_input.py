@@ -49,7 +49,8 @@ RENDER_CASES = ["render_output_path_is_the_render", "render_animation_output_wit
 def blender_main(plan_path):
     import addon_utils
     import bpy
-    plan = json.load(open(plan_path))
+    with open(plan_path) as f:
+        plan = json.load(f)
     sys.path.insert(0, os.environ["MCRECON_ADDON_STAGE"])
     assert addon_utils.enable("mcrecon_addon", default_set=True, handle_error=None), "add-on did not enable"
     scene = bpy.context.scene
@@ -149,7 +150,8 @@ def driver_main():
         os.mkdir(d)
         plan["render"].append((name, d))
     plan_path = os.path.join(root, "plan.json")
-    json.dump(plan, open(plan_path, "w"), indent=1)
+    with open(plan_path, "w") as f:
+        json.dump(plan, f, indent=1)
 
     env = dict(os.environ, BLENDER_USER_CONFIG=os.path.join(root, "config"),
                BLENDER_USER_SCRIPTS=os.path.join(root, "scripts"))
@@ -167,12 +169,14 @@ def driver_main():
               % (10 * n + 30, started[-1] if started else "none"))
         sys.exit(1)
     log = p.stdout + p.stderr
-    open(os.path.join(root, "blender.log"), "w").write(log)
+    with open(os.path.join(root, "blender.log"), "w") as f:
+        f.write(log)
     if p.returncode != 0 or not os.path.exists(plan["result"]):
         print(log[-6000:])
         print("FAIL: Blender exited %d" % p.returncode)
         sys.exit(1)
-    results = json.load(open(plan["result"]))
+    with open(plan["result"]) as f:
+        results = json.load(f)
     failures = []
 
     def fail(name, what):
