@@ -248,8 +248,10 @@ class BadInputMatrix(unittest.TestCase):
             path = c.p(name)
             try:
                 w, h, px = bf.read_rgba(path)
+                unreadable = None
             except AssertionError as e:
-                self.fail(head + "output %s is not a complete image: %s" % (name, e))
+                unreadable = str(e)
+            self.assertIsNone(unreadable, head + "output %s is not a complete image: %s" % (name, unreadable))
             self.assertEqual((w, h), case.size, head + "%s is %dx%d, want %dx%d" % (name, w, h, *case.size))
             bad = int(np.count_nonzero(~np.isfinite(px)))
             self.assertEqual(bad, 0, head + "%s holds %d non-finite values" % (name, bad))
