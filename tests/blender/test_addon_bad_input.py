@@ -8,8 +8,8 @@ The driver builds each case's inputs in its own directory (tests/python/bad_inpu
 hashes everything there, runs Blender once, then checks per case: the operator was cancelled with
 an error report (or the render handler logged `mcrecon: ERROR`) naming the file / parameter as
 given, every input is byte-identical, and no output or temp file is left. The render cases check
-that the render Blender wrote survives (output_path equal to the render's own file; an animation
-whose output path has no ####).
+that the render Blender wrote survives (output_path equal to the render's own file), and that an
+animation whose output path has no #### is refused or writes one file per frame.
 
 Environment: MCRECON_BLENDER, MCRECON_ADDON_STAGE, MCRECON_SOURCE_DIR, MCRECON_TEST_TMP.
 Exit 77 = skipped (ctest SKIP_RETURN_CODE).
@@ -215,14 +215,22 @@ def driver_main():
     if bf.temp_files(d) or sorted(os.listdir(d)) != ["render.exr"]:
         fail(name, "files left: %s" % sorted(os.listdir(d)))
 
-    # An animation with one output file for every frame: refused, naming the output.
+    # An animation with one output path for every frame: either refused (an error naming it) or
+    # every frame in its own complete file; never two frames into one file.
     name = RENDER_CASES[1]
     d = os.path.join(root, name)
     msg = results[name]["message"]
-    frame_errors = [l for l in log.splitlines() if l.startswith("mcrecon: ERROR") and "den.exr" in l]
-    if not frame_errors:
-        fail(name, "no 'mcrecon: ERROR' naming den.exr: every frame was written to one file "
-                   "(last message %r)" % msg)
+    refused = [l for l in log.splitlines() if l.startswith("mcrecon: ERROR") and "den.exr" in l]
+    outputs = sorted(n for n in os.listdir(d) if n.startswith("den"))
+    complete = []
+    for n in outputs:
+        inp = oiio.ImageInput.open(os.path.join(d, n))
+        if inp:
+            complete.append(inp.read_image(0, 0, 0, inp.spec().nchannels, "float") is not None)
+            inp.close()
+    if not refused and not (len(outputs) == 2 and len(complete) == 2 and all(complete)):
+        fail(name, "neither an error naming den.exr nor one complete file per frame: outputs %s "
+                   "(last message %r)" % (outputs, msg))
     for f in (1, 2):
         if not os.path.exists(os.path.join(d, "anim_%04d.exr" % f)):
             fail(name, "render frame %d was not written" % f)
