@@ -134,7 +134,7 @@ std::string dims(std::int64_t w, std::int64_t h, std::int64_t c) {
 }  // namespace
 
 InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path) {
-  const OIIO::ImageSpec& first = in.spec();
+  const OIIO::ImageSpec first = in.spec();  // a copy: seek_subimage changes in.spec()
   const InputBudget budget =
       InputBudget::for_file(path, in.format_name(), first.get_string_attribute("compression"));
   // Sizes in double: a header's int fields multiplied in int would overflow.
