@@ -215,6 +215,13 @@ class LimitsTest(unittest.TestCase):
         rc, msg, _ = self.cli("denoise", ROOM, "-o", self.path("o.exr"), "-f", "box", "--pass", "albedo=" + fifo)
         self.assertEqual(rc, 2, msg)
         self.assertIn("'%s': not a regular file (a FIFO)" % fifo, msg)
+        # And as the demo's sample manifest.
+        data = self.path("data")
+        os.mkdir(data)
+        os.mkfifo(os.path.join(data, "manifest.json"))
+        rc, msg, _ = self.cli("demo", "--samples", data)
+        self.assertEqual(rc, 2, msg)
+        self.assertIn("manifest.json': not a regular file (a FIFO)", msg)
 
     def test_devices_are_refused(self):
         for dev in ("/dev/zero", "/dev/urandom"):
