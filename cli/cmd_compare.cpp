@@ -95,7 +95,7 @@ Run add_compare(CLI::App& app) {
   app.add_option("--layer", a->layer, "view layer of the image");
   app.add_option("--reference-layer", a->ref_layer, "view layer of the reference");
   app.add_option("--frames", a->frames, "frame range A-B for sequences (adds temporal error)");
-  app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  add_threads_option(app, a->threads);
   app.add_flag("--json", a->json, "JSON with keys rmse, relmse, psnr, ssim");
   return [a] { return run_compare(*a); };
 }

@@ -122,7 +122,7 @@ Run add_demo(CLI::App& app) {
       "--spp", [a](const std::vector<int>& v) { a->spp = v; a->spp_given = true; },
       "input sample counts to denoise (default: 16 for stills, the lowest for sequences)");
   app.add_option("--filters", a->filters, "filters to run (default: all)");
-  app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  add_threads_option(app, a->threads);
   app.add_flag("--json", a->json, "also print the table as JSON");
   return [a] { return run_demo(*a); };
 }

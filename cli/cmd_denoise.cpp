@@ -145,7 +145,7 @@ Run add_denoise(CLI::App& app) {
   app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)")->allow_extra_args(false);
   app.add_option("--frames", a->frames, "frame range A-B for a sequence pattern");
   app.add_option("--region", a->region, "only filter X0,Y0,X1,Y1 (end exclusive); the rest keeps the input");
-  app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  add_threads_option(app, a->threads);
   app.add_option("--compression", a->compression, "EXR compression of the output (zip, piz, none, ...)");
   app.add_flag("--keep-passes", a->keep_passes, "carry the input's other channels into the output");
   app.add_flag("--resume", a->resume, "skip frames whose output exists (temporal filters replay them without writing)");

@@ -31,6 +31,7 @@
 #include "history.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
+#include "io/input_limits.h"
 #include "io/output_guard.h"
 #include "io/spec_window.h"
 #include "pipeline/denoise_session.h"
@@ -275,22 +276,18 @@ class McreconInput final : public ImageInput {
     }
   }
 
-  // Width and height of the source, from its header only (no pixels).
+  // Width and height of the source, from its header only (no pixels). The header
+  // must fit what the file can hold (input_limits.h): oiiotool allocates the spec
+  // we return before it asks for a pixel.
   static ImageSpec source_header(const std::string& source) {
-    std::error_code ec;
-    if (!fs::exists(source, ec)) throw mcr::Error(Errc::FileNotFound, "cannot read '" + source + "': no such file");
-    if (fs::is_directory(source, ec))
-      throw mcr::Error(Errc::NotAnImage, "cannot read '" + source + "': it is a directory");
+    mcr::require_regular_file(source);  // before any open(): a FIFO would block it
     auto in = ImageInput::open(source);
     if (!in) {
       const std::string msg = OIIO::geterror();
       throw mcr::Error(Errc::NotAnImage, "cannot read '" + source + "' as an image" + (msg.empty() ? "" : ": " + msg));
     }
-    const ImageSpec spec = in->spec();
-    if (spec.width <= 0 || spec.height <= 0)
-      throw mcr::Error(Errc::ReadFailed, "cannot read '" + source + "': implausible size " +
-                                             std::to_string(spec.width) + "x" + std::to_string(spec.height));
-    return spec;
+    mcr::check_header_fits(*in, source);
+    return in->spec();
   }
 
   mp::Request request_;

@@ -21,6 +21,7 @@
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
 #include "util/error.h"
+#include "util/thread_count.h"
 
 namespace py = pybind11;
 
@@ -301,7 +302,8 @@ py::dict times_dict(const mcr::StageTimes& t) {
 class Session {
  public:
   Session(const std::string& filter, const py::dict& params, int threads, const py::handle& accumulate)
-      : session_(filter, params_from_dict(params), switch_from_py("accumulate", accumulate)), threads_(threads) {}
+      : session_(filter, params_from_dict(params), switch_from_py("accumulate", accumulate)),
+        threads_(mcr::checked_thread_count(threads, "threads=" + std::to_string(threads))) {}
 
   std::string name() { return session_.filter().info().name; }
   bool temporal() { return session_.reconstruction().temporal(); }

@@ -10,6 +10,7 @@
 #include <set>
 
 #include "io/channel_roles.h"
+#include "io/input_limits.h"
 #include "io/spec_window.h"
 #include "util/error.h"
 
@@ -29,12 +30,6 @@ struct RawImage {
   std::shared_ptr<DeepSamples> deep;
 };
 
-void check_path(const std::string& path) {
-  std::error_code ec;
-  if (!fs::exists(path, ec)) throw Error(Errc::FileNotFound, "cannot read '" + path + "': no such file");
-  if (fs::is_directory(path, ec)) throw Error(Errc::NotAnImage, "cannot read '" + path + "': it is a directory");
-}
-
 std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec) {
   auto deep = std::make_shared<DeepSamples>();
   deep->width = spec.width;
@@ -49,13 +44,6 @@ std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec
       for (unsigned s = 0, n = dd.samples(p); s < n; ++s)
         deep->values[std::size_t(c)][deep->offsets[std::size_t(p)] + s] = dd.deep_value(p, c, int(s));
   return deep;
-}
-
-void check_spec(const ImageSpec& spec, const std::string& path) {
-  const double bytes = double(spec.width) * spec.height * std::max(spec.nchannels, 1) * 4.0;
-  if (spec.width <= 0 || spec.height <= 0 || spec.nchannels <= 0 || bytes > 32e9)
-    throw Error(Errc::ReadFailed, "cannot read '" + path + "': implausible size " + std::to_string(spec.width) +
-                                      "x" + std::to_string(spec.height) + "x" + std::to_string(spec.nchannels));
 }
 
 std::string part_label(const ImageSpec& spec, int part) {
@@ -92,7 +80,6 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
                                             std::to_string(spec.x) + "," + std::to_string(spec.y) + "), part 0 " +
                                             std::to_string(raw.width) + "x" + std::to_string(raw.height) + " at (" +
                                             std::to_string(raw.window.x) + "," + std::to_string(raw.window.y) + ")");
-      check_spec(spec, path);
     }
     const std::string part_name = spec.get_string_attribute("name");
     for (const auto& n : spec.channelnames) {
@@ -124,14 +111,15 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
 }
 
 RawImage read_raw(const std::string& path) {
-  check_path(path);
+  require_regular_file(path);  // before any open(): a FIFO would block it
   auto in = ImageInput::open(path);
   if (!in) {
     std::string msg = OIIO::geterror();
     throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
   }
+  // Every allocation below is sized by the header: check it against what the file can hold first.
+  const InputBudget budget = check_header_fits(*in, path);
   const ImageSpec spec = in->spec();
-  check_spec(spec, path);
   RawImage raw;
   raw.width = spec.width;
   raw.height = spec.height;
@@ -139,6 +127,7 @@ RawImage read_raw(const std::string& path) {
   try {
     if (spec.deep) {
       in.reset();
+      check_deep_samples(path, spec.nchannels, budget);
       read_deep(raw, path);
     } else {
       read_parts(*in, raw, path);

@@ -5,6 +5,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "io/input_limits.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -22,6 +23,7 @@ std::string default_samples_dir() {
 
 std::vector<SampleScene> load_sample_manifest(const std::string& dir) {
   const fs::path file = fs::path(dir) / "manifest.json";
+  require_regular_file(file.string());  // a FIFO would block the open below
   std::ifstream in(file);
   if (!in) throw Error(Errc::FileNotFound, "cannot read sample manifest '" + file.string() + "'");
   std::vector<SampleScene> scenes;

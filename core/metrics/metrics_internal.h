@@ -6,12 +6,12 @@
 #include <vector>
 
 #include <tbb/blocked_range.h>
-#include <tbb/global_control.h>
 #include <tbb/parallel_for.h>
 #include <tbb/task_arena.h>
 
 #include "image/image.h"
 #include "util/error.h"
+#include "util/parallel.h"
 
 namespace mcr::metrics_detail {
 
@@ -38,15 +38,12 @@ inline void check_pair(const Image& a, const Image& b, const char* what, const c
 }
 
 // Runs fn(first, last) over [0, count) split into fixed blocks of `block` items, in parallel on
-// `nthreads` threads (<= 0: all cores; more than TBB allows is capped, silently). The split
+// `nthreads` threads (<= 0: all cores; more than the hardware has is clamped, arena_threads). The split
 // does not depend on the thread count.
 template <class Fn>
 void parallel_blocks(int count, int block, int nthreads, const Fn& fn) {
   const int nblocks = (count + block - 1) / block;
-  const int allowed =
-      int(tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism));
-  tbb::task_arena arena(nthreads > 0 ? (nthreads < allowed ? nthreads : allowed)
-                                     : tbb::task_arena::automatic);
+  tbb::task_arena arena(arena_threads(nthreads));
   arena.execute([&] {
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nblocks, 1),

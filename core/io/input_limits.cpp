@@ -1,0 +1,225 @@
+#include "io/input_limits.h"
+
+#include <OpenEXR/ImfDeepFrameBuffer.h>
+#include <OpenEXR/ImfDeepScanLineInputPart.h>
+#include <OpenEXR/ImfDeepTiledInputPart.h>
+#include <OpenEXR/ImfHeader.h>
+#include <OpenEXR/ImfMultiPartInputFile.h>
+#include <OpenEXR/ImfPartType.h>
+#include <sys/stat.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <vector>
+
+#include "util/error.h"
+
+namespace mcr {
+
+void require_regular_file(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) {
+    const int err = errno;
+    if (err == ENOENT || err == ENOTDIR) throw Error(Errc::FileNotFound, "cannot read '" + path + "': no such file");
+    throw Error(Errc::ReadFailed, "cannot read '" + path + "': " + std::strerror(err));
+  }
+  if (S_ISREG(st.st_mode)) return;
+  const char* what = S_ISDIR(st.st_mode)    ? "it is a directory"
+                     : S_ISFIFO(st.st_mode) ? "not a regular file (a FIFO)"
+                     : S_ISCHR(st.st_mode)  ? "not a regular file (a character device)"
+                     : S_ISBLK(st.st_mode)  ? "not a regular file (a block device)"
+                     : S_ISSOCK(st.st_mode) ? "not a regular file (a socket)"
+                                            : "not a regular file";
+  throw Error(Errc::NotAnImage, "cannot read '" + path + "': " + what);
+}
+
+std::uint64_t parse_byte_count(const std::string& text, const std::string& what) {
+  const auto bad = [&] {
+    return Error(Errc::InvalidArgument, what + "='" + text +
+                                            "': expected a positive byte count such as 500M, 8G or 2GiB "
+                                            "(K, M, G, T: powers of 1000; Ki, Mi, Gi, Ti: of 1024)");
+  };
+  std::size_t used = 0;
+  double value = 0.0;
+  try {
+    value = std::stod(text, &used);
+  } catch (const std::exception&) {
+    throw bad();
+  }
+  std::string unit = text.substr(used);
+  if (!unit.empty() && (unit.back() == 'B' || unit.back() == 'b')) unit.pop_back();
+  double scale = 1.0;
+  if (!unit.empty()) {
+    const bool binary = unit.size() == 2 && (unit[1] == 'i' || unit[1] == 'I');
+    if (unit.size() != 1 && !binary) throw bad();
+    const std::string prefixes = "KMGT";
+    const auto k = prefixes.find(char(std::toupper(static_cast<unsigned char>(unit[0]))));
+    if (k == std::string::npos) throw bad();
+    scale = std::pow(binary ? 1024.0 : 1000.0, double(k + 1));
+  }
+  const double bytes = value * scale;
+  if (!std::isfinite(bytes) || bytes < 1.0 || bytes > 1e18) throw bad();
+  return std::uint64_t(bytes);
+}
+
+std::string byte_text(double bytes) {
+  static const char* units[] = {"bytes", "KB", "MB", "GB", "TB", "PB", "EB"};
+  int u = 0;
+  while (bytes >= 999.5 && u < 6) {
+    bytes /= 1000.0;
+    ++u;
+  }
+  char buf[32];
+  std::snprintf(buf, sizeof buf, u == 0 ? "%.0f %s" : "%.3g %s", bytes, units[u]);
+  return buf;
+}
+
+// Float bytes per file byte, measured on constant images (the best case of every
+// compression) written by OpenImageIO 2.4 / OpenEXR 3.1, 1024^2 to 8192^2, RGB(A),
+// half and float, scanline and tiled; each bound is about twice the best seen:
+//   none 2 (half read as float), rle 128, b44/b44a 21, piz 744, pxr24 1608,
+//   zip/zips 2055 (deflate's 1032:1 on half data), dwaa/dwab 63777.
+// Other formats (PNG palette or 1-bit images, GIF) can exceed zip's figure, so
+// they, and compressions not listed, get the largest bound.
+double max_expansion(const std::string& format, const std::string& compression) {
+  constexpr double kLargest = 262144;
+  if (format != "openexr") return kLargest;
+  const std::string c = compression.substr(0, compression.find(':'));  // "dwaa:45" -> "dwaa"
+  if (c == "none" || c.empty()) return 4;
+  if (c == "rle") return 256;
+  if (c == "b44" || c == "b44a") return 64;
+  if (c == "zip" || c == "zips" || c == "piz" || c == "pxr24") return 4096;
+  return kLargest;
+}
+
+InputBudget InputBudget::for_file(const std::string& path, const std::string& format, const std::string& compression) {
+  InputBudget b;
+  struct stat st {};
+  b.file_bytes_ = ::stat(path.c_str(), &st) == 0 ? std::uint64_t(st.st_size) : 0;
+  if (const char* env = std::getenv("MCRECON_MAX_MEMORY"); env && *env) {
+    b.user_limit_ = env;
+    b.bytes_ = parse_byte_count(env, "MCRECON_MAX_MEMORY");
+    return b;
+  }
+  const double from_file = double(b.file_bytes_) * max_expansion(format, compression) + kFloor;
+  b.capped_ = from_file > kAbsoluteCap;
+  b.bytes_ = std::uint64_t(std::min(from_file, kAbsoluteCap));
+  return b;
+}
+
+void InputBudget::check(const std::string& path, double bytes, const std::string& claim) const {
+  if (bytes <= double(bytes_)) return;
+  std::string limit;
+  if (!user_limit_.empty())
+    limit = "MCRECON_MAX_MEMORY=" + user_limit_ + " allows " + byte_text(double(bytes_));
+  else if (capped_)
+    limit = "no input may use more than " + byte_text(double(bytes_)) + " (set MCRECON_MAX_MEMORY to allow more)";
+  else
+    limit = "the " + byte_text(double(file_bytes_)) + " file can hold at most ~" + byte_text(double(bytes_)) +
+            " of pixels (set MCRECON_MAX_MEMORY to allow more)";
+  throw Error(Errc::ReadFailed,
+              "cannot read '" + path + "': " + claim + " (" + byte_text(bytes) + ") but " + limit);
+}
+
+namespace {
+
+std::string dims(std::int64_t w, std::int64_t h, std::int64_t c) {
+  return std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c) + " float";
+}
+
+}  // namespace
+
+InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path) {
+  const OIIO::ImageSpec first = in.spec();  // a copy: seek_subimage changes in.spec()
+  const InputBudget budget =
+      InputBudget::for_file(path, in.format_name(), first.get_string_attribute("compression"));
+  // Sizes in double: a header's int fields multiplied in int would overflow.
+  double total = 0.0;
+  std::int64_t channels = 0;
+  int parts = 0;
+  bool same_size = true;
+  for (int part = 0; in.seek_subimage(part, 0); ++part) {
+    const OIIO::ImageSpec& s = in.spec();
+    if (s.width <= 0 || s.height <= 0 || s.nchannels <= 0)
+      throw Error(Errc::ReadFailed, "cannot read '" + path + "': implausible size " + std::to_string(s.width) + "x" +
+                                        std::to_string(s.height) + "x" + std::to_string(s.nchannels));
+    if (part > 0 && s.deep) continue;  // the reader skips deep parts after the first
+    const double w = s.width, h = s.height, c = s.nchannels, d = std::max(s.depth, 1);
+    // A deep part: per-pixel sample tables (counts, offsets, capacities) beside the flattened float pixels.
+    total += w * h * d * (c * 4.0 + (s.deep ? 32.0 : 0.0));
+    channels += s.nchannels;
+    same_size = same_size && s.width == first.width && s.height == first.height;
+    ++parts;
+    if (s.tile_width > 0) {  // a tiled read buffers a whole row of tiles, and a tile may exceed the image
+      const double tw = s.tile_width, th = s.tile_height, td = std::max(s.tile_depth, 1);
+      const double row = std::ceil(w / tw) * tw * th * td * c * 4.0;
+      budget.check(path, row, "its header asks for tiles of " + dims(s.tile_width, s.tile_height, s.nchannels) + ", read a row at a time");
+    }
+  }
+  in.seek_subimage(0, 0);
+  std::string asks = same_size ? dims(first.width, first.height, channels) +
+                                           (parts > 1 ? " in " + std::to_string(parts) + " parts" : "")
+                                     : std::to_string(parts) + " parts of " + std::to_string(channels) +
+                                           " float channels in all";
+  if (first.deep) asks += " deep, with per-pixel sample tables";
+  budget.check(path, total, "its header asks for " + asks);
+  return budget;
+}
+
+void check_deep_samples(const std::string& path, int nchannels, const InputBudget& budget) {
+  namespace imf = OPENEXR_IMF_NAMESPACE;
+  std::uint64_t samples = 0;
+  try {
+    imf::MultiPartInputFile file(path.c_str());
+    const imf::Header& header = file.header(0);
+    const IMATH_NAMESPACE::Box2i dw = header.dataWindow();
+    const std::int64_t width = std::int64_t(dw.max.x) - dw.min.x + 1;
+    std::vector<unsigned> counts;
+    // Counts land in `counts`, laid out as rows [y0, y0 + rows) of the data window.
+    const auto frame_for = [&](int y0, std::int64_t rows) {
+      counts.assign(std::size_t(width * rows), 0u);
+      char* origin = reinterpret_cast<char*>(counts.data()) -
+                     (std::intptr_t(dw.min.x) + std::intptr_t(y0) * width) * std::intptr_t(sizeof(unsigned));
+      imf::DeepFrameBuffer fb;
+      fb.insertSampleCountSlice(imf::Slice(imf::UINT, origin, sizeof(unsigned), std::size_t(width) * sizeof(unsigned)));
+      return fb;
+    };
+    const auto add = [&] {
+      for (unsigned n : counts) samples += n;
+    };
+    if (header.type() == imf::DEEPSCANLINE) {
+      imf::DeepScanLineInputPart part(file, 0);
+      constexpr int kBand = 64;
+      for (std::int64_t y = dw.min.y; y <= dw.max.y; y += kBand) {
+        const std::int64_t y1 = std::min<std::int64_t>(y + kBand - 1, dw.max.y);
+        part.setFrameBuffer(frame_for(int(y), y1 - y + 1));
+        part.readPixelSampleCounts(int(y), int(y1));
+        add();
+      }
+    } else if (header.type() == imf::DEEPTILE) {
+      imf::DeepTiledInputPart part(file, 0);
+      for (int ty = 0; ty < part.numYTiles(0); ++ty) {
+        const IMATH_NAMESPACE::Box2i tile = part.dataWindowForTile(0, ty, 0);
+        part.setFrameBuffer(frame_for(tile.min.y, std::int64_t(tile.max.y) - tile.min.y + 1));
+        part.readPixelSampleCounts(0, part.numXTiles(0) - 1, ty, ty, 0, 0);
+        add();
+      }
+    } else {
+      return;  // not deep: nothing to count
+    }
+  } catch (const Error&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw Error(Errc::ReadFailed, "cannot read the sample counts of deep '" + path + "' (truncated or corrupt?): " +
+                                      e.what());
+  }
+  budget.check(path, double(samples) * nchannels * 4.0,
+               "its sample counts ask for " + std::to_string(samples) + " deep samples x " + std::to_string(nchannels) +
+                   " float channels");
+}
+
+}  // namespace mcr

@@ -1,0 +1,62 @@
+#pragma once
+// Limits from the input: which paths are read as images, and how much memory a
+// file may make us allocate. A header can claim any size; what a file can hold
+// is bounded by its size on disk times the best ratio its compression reaches.
+// MCRECON_MAX_MEMORY (bytes: "8G", "500M", "2GiB") replaces that bound in every
+// front end (CLI, OIIO plugin, Python module, Blender add-on).
+#include <cstdint>
+#include <string>
+
+#include <OpenImageIO/imageio.h>
+
+namespace mcr {
+
+// Throws unless `path` names a regular file (symlinks followed): FileNotFound, or
+// NotAnImage for a directory, FIFO, device or socket. Uses stat only: opening a
+// FIFO for reading blocks, and /dev/zero never ends.
+void require_regular_file(const std::string& path);
+
+// "8G" -> 8e9, "2GiB" -> 2^31, "500000" -> 500000 (K, M, G, T: powers of 1000;
+// Ki, Mi, Gi, Ti: of 1024; an optional trailing B). Throws InvalidArgument naming `what`.
+std::uint64_t parse_byte_count(const std::string& text, const std::string& what);
+
+// "160 GB", "800 KB", "12 bytes" (decimal units, 3 significant digits).
+std::string byte_text(double bytes);
+
+// The most float pixel bytes one byte of a file in this format and compression
+// can hold (see input_limits.cpp for the measurements behind each figure).
+double max_expansion(const std::string& format, const std::string& compression);
+
+// The pixel memory one input may make us allocate.
+class InputBudget {
+ public:
+  // MCRECON_MAX_MEMORY when set, else file size x max_expansion + a floor, at
+  // most kAbsoluteCap. Throws InvalidArgument for a malformed MCRECON_MAX_MEMORY.
+  static InputBudget for_file(const std::string& path, const std::string& format, const std::string& compression);
+  std::uint64_t bytes() const { return bytes_; }
+  // Throws ReadFailed when `bytes` exceeds the budget: "cannot read 'x.exr': <claim>
+  // (160 GB) but the 800 KB file can hold at most ~3.28 GB of pixels (set
+  // MCRECON_MAX_MEMORY to allow more)"; claim: "its header asks for 100000x100000x4 float".
+  void check(const std::string& path, double bytes, const std::string& claim) const;
+
+  static constexpr double kAbsoluteCap = 32e9;  // without MCRECON_MAX_MEMORY, whatever the file
+  static constexpr double kFloor = 64e6;         // any file may use this much: small images always read
+
+ private:
+  std::uint64_t bytes_ = 0;
+  std::uint64_t file_bytes_ = 0;
+  std::string user_limit_;  // MCRECON_MAX_MEMORY as the user typed it ("" = from the file)
+  bool capped_ = false;     // the absolute cap, not the file, set bytes_
+};
+
+// Checks an opened image's header against its file's budget before any pixel is
+// allocated: every part's pixels as float (all parts are held at once), a row of
+// tiles (what a tiled read buffers), and a deep part's per-pixel tables.
+InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path);
+
+// For a deep OpenEXR file: counts the samples of part 0 from its sample-count
+// tables alone (a row band at a time, no sample data) and checks samples x
+// channels as float against the budget, before anything reads them.
+void check_deep_samples(const std::string& path, int nchannels, const InputBudget& budget);
+
+}  // namespace mcr
