@@ -7,6 +7,7 @@
 #include <OpenEXR/ImfMultiPartInputFile.h>
 #include <OpenEXR/ImfPartType.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
@@ -96,6 +97,12 @@ double max_expansion(const std::string& format, const std::string& compression) 
   return kLargest;
 }
 
+double InputBudget::absolute_cap() {
+  const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+  if (pages <= 0 || page <= 0) return kAbsoluteCap;
+  return std::min(kAbsoluteCap, 0.5 * double(pages) * double(page));
+}
+
 InputBudget InputBudget::for_file(const std::string& path, const std::string& format, const std::string& compression) {
   InputBudget b;
   struct stat st {};
@@ -106,8 +113,9 @@ InputBudget InputBudget::for_file(const std::string& path, const std::string& fo
     return b;
   }
   const double from_file = double(b.file_bytes_) * max_expansion(format, compression) + kFloor;
-  b.capped_ = from_file > kAbsoluteCap;
-  b.bytes_ = std::uint64_t(std::min(from_file, kAbsoluteCap));
+  const double cap = absolute_cap();
+  b.capped_ = from_file > cap;
+  b.bytes_ = std::uint64_t(std::min(from_file, cap));
   return b;
 }
 
@@ -117,7 +125,8 @@ void InputBudget::check(const std::string& path, double bytes, const std::string
   if (!user_limit_.empty())
     limit = "MCRECON_MAX_MEMORY=" + user_limit_ + " allows " + byte_text(double(bytes_));
   else if (capped_)
-    limit = "no input may use more than " + byte_text(double(bytes_)) + " (set MCRECON_MAX_MEMORY to allow more)";
+    limit = "no input may use more than " + byte_text(double(bytes_)) +
+            " (half this machine's memory, at most 32 GB; set MCRECON_MAX_MEMORY to allow more)";
   else
     limit = "the " + byte_text(double(file_bytes_)) + " file can hold at most ~" + byte_text(double(bytes_)) +
             " of pixels (set MCRECON_MAX_MEMORY to allow more)";

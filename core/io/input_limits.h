@@ -31,7 +31,7 @@ double max_expansion(const std::string& format, const std::string& compression);
 class InputBudget {
  public:
   // MCRECON_MAX_MEMORY when set, else file size x max_expansion + a floor, at
-  // most kAbsoluteCap. Throws InvalidArgument for a malformed MCRECON_MAX_MEMORY.
+  // most absolute_cap(). Throws InvalidArgument for a malformed MCRECON_MAX_MEMORY.
   static InputBudget for_file(const std::string& path, const std::string& format, const std::string& compression);
   std::uint64_t bytes() const { return bytes_; }
   // Throws ReadFailed when `bytes` exceeds the budget: "cannot read 'x.exr': <claim>
@@ -40,6 +40,10 @@ class InputBudget {
   void check(const std::string& path, double bytes, const std::string& claim) const;
 
   static constexpr double kAbsoluteCap = 32e9;  // without MCRECON_MAX_MEMORY, whatever the file
+  // kAbsoluteCap, or half this machine's memory when less: a claim past that cannot be
+  // served (a frame is held several times over while it is filtered), whatever the
+  // compression ratio would allow (DWA reaches ~64000:1 on black frames).
+  static double absolute_cap();
   static constexpr double kFloor = 64e6;         // any file may use this much: small images always read
 
  private:
