@@ -8,6 +8,7 @@
 #include "metrics/metrics.h"
 #include "progress.h"
 #include "util/error.h"
+#include "validators.h"
 
 namespace mcr::cli {
 
@@ -95,7 +96,7 @@ Run add_compare(CLI::App& app) {
   app.add_option("--layer", a->layer, "view layer of the image");
   app.add_option("--reference-layer", a->ref_layer, "view layer of the reference");
   app.add_option("--frames", a->frames, "frame range A-B for sequences (adds temporal error)");
-  app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(CLI::NonNegativeNumber);
+  app.add_option("-j,--threads", a->threads, "threads (0 = all cores)")->check(whole_number(0));
   app.add_flag("--json", a->json, "JSON with keys rmse, relmse, psnr, ssim");
   return [a] { return run_compare(*a); };
 }
