@@ -52,9 +52,12 @@ void report_unused(const ParamSet& params, const std::string& name, const std::s
 std::string number_text(double v) {
   if (std::isnan(v)) return "nan";
   if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  // The fewest digits that read back as v, but whole digits up to 6 of them ("10", not
+  // "1e+01"; "1e+06" as %g prints it).
+  const int whole = v == 0 ? 1 : int(std::floor(std::log10(std::fabs(v)))) + 1;
   char buf[32];
-  for (int prec = 1; prec <= 17; ++prec) {  // the fewest digits that read back as v
-    std::snprintf(buf, sizeof buf, "%.*g", prec, v);
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", whole >= prec && whole <= 6 ? whole : prec, v);
     if (std::strtod(buf, nullptr) == v) break;
   }
   return buf;
