@@ -8,6 +8,7 @@
 #include "metrics/metrics.h"
 #include "progress.h"
 #include "util/error.h"
+#include "validators.h"
 
 namespace mcr::cli {
 

@@ -1,6 +1,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <set>
 
 #include "commands.h"
 #include "filters/registry.h"
@@ -11,6 +12,7 @@
 #include "pipeline/evaluate.h"
 #include "progress.h"
 #include "util/error.h"
+#include "validators.h"
 
 namespace mcr::cli {
 
@@ -40,11 +42,26 @@ void print_row(const Row& r, bool timed) {
   std::fflush(stdout);
 }
 
+// Every --spp level must be one some scene has: a level none has would run nothing.
+void check_spp(const std::vector<int>& spp, const std::vector<SampleScene>& scenes, const std::string& dir) {
+  std::set<int> levels;
+  for (const SampleScene& s : scenes)
+    for (const auto& [n, path] : s.noisy) levels.insert(n);
+  for (int n : spp) {
+    if (levels.count(n)) continue;
+    std::string have;
+    for (int l : levels) have += (have.empty() ? "" : ", ") + std::to_string(l);
+    throw Error(Errc::InvalidArgument, "--spp " + std::to_string(n) + ": no sample scene in '" + dir + "' has " +
+                                           std::to_string(n) + " spp; the levels there are " + have);
+  }
+}
+
 int run_demo(const DemoArgs& a) {
   const std::string dir = a.samples.empty() ? default_samples_dir() : a.samples;
   const std::vector<SampleScene> scenes = load_sample_manifest(dir);
   std::vector<std::string> filters = a.filters.empty() ? filter_names() : a.filters;
   for (const auto& f : filters) filter_info(f);  // unknown names fail before any work
+  if (a.spp_given) check_spp(a.spp, scenes, dir);
   std::filesystem::create_directories(a.out);
 
   std::printf("%-8s %-9s %-14s %9s %10s %8s %7s %9s\n", "scene", "input", "filter", "seconds", "relMSE", "PSNR", "SSIM",
@@ -120,7 +137,8 @@ Run add_demo(CLI::App& app) {
   app.add_option("-o,--out", a->out, "directory for side-by-side PNGs and results.json");
   app.add_option_function<std::vector<int>>(
       "--spp", [a](const std::vector<int>& v) { a->spp = v; a->spp_given = true; },
-      "input sample counts to denoise (default: 16 for stills, the lowest for sequences)");
+      "input sample counts to denoise (default: 16 for stills, the lowest for sequences)")
+      ->check(whole_number(1));
   app.add_option("--filters", a->filters, "filters to run (default: all)");
   add_threads_option(app, a->threads);
   app.add_flag("--json", a->json, "also print the table as JSON");

@@ -6,10 +6,12 @@
 
 #include "commands.h"
 #include "io/atomic_write.h"
+#include "io/exr_output.h"
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
 #include "progress.h"
 #include "util/error.h"
+#include "validators.h"
 
 namespace mcr::cli {
 
@@ -49,6 +51,7 @@ int run_denoise(const DenoiseArgs& a) {
   std::vector<std::pair<std::string, std::string>> params;
   for (const auto& s : a.sets) params.push_back(parse_key_value(s, "--set"));
   DenoiseSession session(a.filter, params, a.accumulate);  // unknown filter / parameter errors first
+  check_exr_name(a.output);
 
   ReadOptions ro;
   ro.layer = a.layer;
@@ -56,7 +59,7 @@ int run_denoise(const DenoiseArgs& a) {
   for (const auto& p : a.passes) ro.overrides.push_back(parse_pass_override(p));
   WriteOptions wo;
   wo.keep_passes = a.keep_passes;
-  wo.compression = a.compression;
+  wo.compression = checked_exr_compression(a.compression);
   ExecOptions eo;
   eo.nthreads = a.threads;
   if (!a.region.empty()) eo.roi = parse_region(a.region);
@@ -107,8 +110,19 @@ int run_denoise(const DenoiseArgs& a) {
   int written = 0, skipped = 0;
   for (std::size_t i = 0; i < jobs.size(); ++i) {
     const auto& [in, out] = jobs[i];
+    // --resume: an output counts as done only if it reads completely (a run killed by
+    // SIGKILL or a full disk may have left it cut short).
     std::error_code ec;
-    const bool done = a.resume && std::filesystem::exists(out, ec);
+    bool done = a.resume && std::filesystem::exists(out, ec);
+    if (done) {
+      const std::string why = incomplete_file_reason(out);
+      if (!why.empty()) {
+        done = false;
+        const std::string note = "redo " + out + " (unreadable: " + why + ")";
+        if (seq) progress.step(int(i), note);
+        else std::cerr << "mcrecon: " << note << "\n";
+      }
+    }
     if (done && !temporal) {
       ++skipped;
       if (seq) progress.step(int(i + 1), "skip " + out + " (exists)");

@@ -3,10 +3,12 @@
 
 #include "commands.h"
 #include "io/atomic_write.h"
+#include "io/exr_output.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
 #include "sparse/expanded_grid.h"
 #include "util/error.h"
+#include "validators.h"
 
 namespace mcr::cli {
 
@@ -26,6 +28,7 @@ int run_sparsify(const SparsifyArgs& a) {
   p.gaze_y = std::stod(m[2]);
   p.density = a.density;
   p.fovea_radius = a.fovea;
+  check_exr_name(a.output);
   check_output_path(a.output, {a.input});
   ReadOptions ro;
   ro.layer = a.layer;
@@ -51,9 +54,9 @@ Run add_sparsify(CLI::App& app) {
   auto a = std::make_shared<SparsifyArgs>();
   app.add_option("input", a->input, "full render")->required();
   app.add_option("-o,--output", a->output, "sparse render with a sample_count pass (0 = hole)")->required();
-  app.add_option("--density", a->density, "fraction of pixels sampled")->check(CLI::Range(1e-4, 1.0));
+  app.add_option("--density", a->density, "fraction of pixels sampled")->check(number_in(1e-4, 1.0));
   app.add_option("--gaze", a->gaze, "gaze point X,Y as fractions of width and height");
-  app.add_option("--fovea-radius", a->fovea, "fully sampled radius, fraction of the diagonal")->check(CLI::Range(0.0, 2.0));
+  app.add_option("--fovea-radius", a->fovea, "fully sampled radius, fraction of the diagonal")->check(number_in(0.0, 2.0));
   app.add_option("--layer", a->layer, "view layer");
   return [a] { return run_sparsify(*a); };
 }

@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <iostream>
 #include <map>
+#include <string>
 
 #include "commands.h"
 #include "io/atomic_write.h"
@@ -15,6 +16,20 @@ extern "C" void on_signal(int sig) {
   mcr::remove_pending_temp();
   std::signal(sig, SIG_DFL);
   std::raise(sig);
+}
+
+// CLI11 says "A subcommand is required" for a misspelt command too: name what was typed and
+// list the commands. Errors inside a command (unknown option, missing or bad value) are
+// CLI11's own, which name the option and the value.
+std::string parse_error_text(CLI::App& app, const CLI::ParseError& e, int argc, char** argv) {
+  if (!app.get_subcommands().empty()) return e.what();
+  std::string names;
+  for (const CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  if (argc < 2) return "no command given; commands: " + names;
+  const std::string first = argv[1];
+  if (!first.empty() && first[0] != '-') return "unknown command '" + first + "'; commands: " + names;
+  return "expected a command before '" + first + "'; commands: " + names;
 }
 
 }  // namespace
@@ -51,7 +66,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForVersion& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::cerr << "mcrecon: error: " << e.what() << "\n";
+    std::cerr << "mcrecon: error: " << parse_error_text(app, e, argc, argv) << "\n";
     return 2;
   }
   try {

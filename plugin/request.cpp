@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "io/exr_output.h"
 #include "util/error.h"
 
 namespace mcr::plugin {
@@ -71,7 +72,7 @@ Request make_request(const std::string& source, const KeyValues& settings, bool 
     } else if (output_side && key == "keep_passes") {
       r.keep_passes = parse_switch(key, value, source);
     } else if (output_side && key == "compression") {
-      r.compression = value;
+      r.compression = checked_exr_compression(value);  // OIIO would write zip for a bad name
     } else {
       r.params.emplace_back(key, value);
     }

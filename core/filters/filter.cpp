@@ -107,6 +107,24 @@ std::vector<Role> Filter::missing_passes(const Frame& frame) const {
   return missing;
 }
 
+namespace {
+
+// A region must lie inside the image, in the pixel indices of its data window: a region
+// partly or wholly outside is a mistake the user should hear about, not a smaller region.
+Roi checked_roi(const Roi& r, int w, int h) {
+  const std::string text = "region " + std::to_string(r.x0) + "," + std::to_string(r.y0) + "," +
+                           std::to_string(r.x1) + "," + std::to_string(r.y1);
+  if (r.empty())
+    throw Error(Errc::InvalidArgument, text + " is empty (X0,Y0,X1,Y1 with X0 < X1 and Y0 < Y1, end exclusive)");
+  if (r.x0 < 0 || r.y0 < 0 || r.x1 > w || r.y1 > h)
+    throw Error(Errc::InvalidArgument, text + " is outside the " + std::to_string(w) + "x" + std::to_string(h) +
+                                           " image (x in [0, " + std::to_string(w) + "), y in [0, " +
+                                           std::to_string(h) + "))");
+  return r;
+}
+
+}  // namespace
+
 Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   if (!committed_) throw Error(Errc::Internal, "filter '" + info_.name + "': execute() before commit()");
   check_passes(needs(), frame, "filter '" + info_.name + "'");
@@ -115,8 +133,8 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   const int nthreads = options.nthreads;
   const int w = frame.width, h = frame.height;
   const Image& input = frame.image(Role::Colour);
-  const Roi roi = options.roi.empty() ? Roi::all(w, h) : options.roi.clipped(w, h);
-  if (roi.empty()) {  // nothing to filter: the input as it is (non-finite values to 0)
+  const Roi roi = options.roi == Roi{} ? Roi::all(w, h) : checked_roi(options.roi, w, h);
+  if (roi.empty()) {  // a 0-pixel frame: the input as it is
     prepared_ = Prepared{};
     Image out = rgb_copy(input, nthreads);
     repaired_ = finish(prepared_, input, roi, nthreads, out);

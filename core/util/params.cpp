@@ -2,8 +2,9 @@
 
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
-#include <sstream>
+#include <limits>
 
 #include "util/error.h"
 
@@ -48,14 +49,23 @@ void report_unused(const ParamSet& params, const std::string& name, const std::s
   if (params.has(name) && params.was_set(name)) out.push_back(name + " has no effect " + why);
 }
 
+std::string number_text(double v) {
+  if (std::isnan(v)) return "nan";
+  if (std::isinf(v)) return v > 0 ? "inf" : "-inf";
+  // The fewest digits that read back as v, but whole digits up to 6 of them ("10", not
+  // "1e+01"; "1e+06" as %g prints it).
+  const int whole = v == 0 ? 1 : int(std::floor(std::log10(std::fabs(v)))) + 1;
+  char buf[32];
+  for (int prec = 1; prec <= 17; ++prec) {
+    std::snprintf(buf, sizeof buf, "%.*g", whole >= prec && whole <= 6 ? whole : prec, v);
+    if (std::strtod(buf, nullptr) == v) break;
+  }
+  return buf;
+}
+
 std::string param_value_text(const ParamValue& v) {
   if (auto i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);
-  if (auto d = std::get_if<double>(&v)) {
-    std::ostringstream os;
-    os.precision(9);
-    os << *d;
-    return os.str();
-  }
+  if (auto d = std::get_if<double>(&v)) return number_text(*d);
   if (auto b = std::get_if<bool>(&v)) return *b ? "true" : "false";
   return std::get<std::string>(v);
 }
@@ -79,22 +89,58 @@ const ParamSpec& ParamSet::spec(const std::string& name) const {
 
 namespace {
 
-[[noreturn]] void out_of_range(const std::string& owner, const ParamSpec& s, const std::string& value) {
-  throw Error(Errc::ParameterOutOfRange,
-              "parameter '" + s.name + "' of filter '" + owner + "' must be " + param_range_text(s) + ", got " + value);
+// A bound at infinity or at the end of its type is no bound: printed as such, never as
+// 300 digits of DBL_MAX.
+bool bounded(const ParamSpec& s, double b) {
+  if (!std::isfinite(b) || std::fabs(b) == std::numeric_limits<double>::max()) return false;
+  return s.type != ParamType::Int || std::fabs(b) < 9.2e18;
 }
 
-[[noreturn]] void bad_value(const std::string& owner, const ParamSpec& s, const std::string& text) {
-  throw Error(Errc::BadParameterValue, "parameter '" + s.name + "' of filter '" + owner + "' expects " +
-                                           param_type_name(s.type) + ", got '" + text + "'");
+std::string bound_text(const ParamSpec& s, double b) {
+  return s.type == ParamType::Int ? std::to_string(std::int64_t(b)) : number_text(b);
 }
+
+// "in [0, 64]", ">= 0 (no upper bound)", "one of: a, b": what a valid value is.
+std::string valid_text(const ParamSpec& s) {
+  const std::string r = param_range_text(s);
+  return r.empty() || r[0] != '[' ? r : "in " + r;
+}
+
+std::string prefix(const std::string& owner, const ParamSpec& s) {
+  return "parameter '" + s.name + "' of filter '" + owner + "'";
+}
+
+// `given` is what the caller gave, as the messages show it: the user's own text quoted
+// (set_text), a typed value printed readably (set).
+[[noreturn]] void out_of_range(const std::string& owner, const ParamSpec& s, const std::string& given) {
+  throw Error(Errc::ParameterOutOfRange, prefix(owner, s) + " must be " + valid_text(s) + ", got " + given);
+}
+
+[[noreturn]] void bad_value(const std::string& owner, const ParamSpec& s, const std::string& given) {
+  std::string want;
+  switch (s.type) {
+    case ParamType::Int: want = "an integer " + valid_text(s); break;
+    case ParamType::Float: want = "a finite number " + valid_text(s); break;
+    case ParamType::Bool: want = "a bool (1, true, on, yes or 0, false, off, no)"; break;
+    case ParamType::Enum: want = valid_text(s); break;
+  }
+  throw Error(Errc::BadParameterValue, prefix(owner, s) + " expects " + want + ", got " + given);
+}
+
+std::string quoted(const std::string& text) { return "'" + text + "'"; }
 
 }  // namespace
 
 std::string param_range_text(const ParamSpec& s) {
   switch (s.type) {
-    case ParamType::Int: return "[" + std::to_string(std::int64_t(s.min)) + ", " + std::to_string(std::int64_t(s.max)) + "]";
-    case ParamType::Float: return "[" + param_value_text(s.min) + ", " + param_value_text(s.max) + "]";
+    case ParamType::Int:
+    case ParamType::Float: {
+      const bool lo = bounded(s, s.min), hi = bounded(s, s.max);
+      if (lo && hi) return "[" + bound_text(s, s.min) + ", " + bound_text(s, s.max) + "]";
+      if (lo) return ">= " + bound_text(s, s.min) + " (no upper bound)";
+      if (hi) return "<= " + bound_text(s, s.max) + " (no lower bound)";
+      return "any number";
+    }
     case ParamType::Bool: return "";
     case ParamType::Enum: {
       std::string r;
@@ -106,41 +152,48 @@ std::string param_range_text(const ParamSpec& s) {
 }
 
 void ParamSet::set(const std::string& name, const ParamValue& value) {
+  // A typed value has no text of its own: printed readably, a string quoted.
+  set_checked(name, value,
+              std::holds_alternative<std::string>(value) ? quoted(std::get<std::string>(value)) : param_value_text(value));
+}
+
+void ParamSet::set_checked(const std::string& name, const ParamValue& value, const std::string& given) {
   const ParamSpec& s = spec(name);
-  const std::string text = param_value_text(value);
   ParamValue v = value;
   switch (s.type) {
     case ParamType::Int: {
-      std::int64_t i;
-      if (auto p = std::get_if<std::int64_t>(&value)) i = *p;
-      else if (auto d = std::get_if<double>(&value); d && std::isfinite(*d) && *d == std::floor(*d) && std::fabs(*d) < 9e15) i = std::int64_t(*d);
-      else bad_value(owner_, s, text);
-      if (double(i) < s.min || double(i) > s.max) out_of_range(owner_, s, text);
-      v = i;
+      // Whole numbers only; a huge one is out of range (not a type error) and is never
+      // cast to int64 before it is known to fit.
+      const auto* p = std::get_if<std::int64_t>(&value);
+      const auto* q = std::get_if<double>(&value);
+      if (!p && !(q && std::isfinite(*q) && *q == std::floor(*q))) bad_value(owner_, s, given);
+      const double d = p ? double(*p) : *q;
+      if (d < s.min || d > s.max || (!p && std::fabs(d) >= 9.2e18)) out_of_range(owner_, s, given);
+      v = p ? *p : std::int64_t(d);
       break;
     }
     case ParamType::Float: {
       double d;
       if (auto p = std::get_if<double>(&value)) d = *p;
       else if (auto i = std::get_if<std::int64_t>(&value)) d = double(*i);
-      else bad_value(owner_, s, text);
-      if (!std::isfinite(d)) bad_value(owner_, s, text);  // ranges are finite; inf is never meant
-      if (d < s.min || d > s.max) out_of_range(owner_, s, text);
+      else bad_value(owner_, s, given);
+      if (!std::isfinite(d)) bad_value(owner_, s, given);  // ranges are finite; inf is never meant
+      if (d < s.min || d > s.max) out_of_range(owner_, s, given);
       v = d;
       break;
     }
     case ParamType::Bool:
       if (!std::holds_alternative<bool>(value)) {
         if (auto i = std::get_if<std::int64_t>(&value); i && (*i == 0 || *i == 1)) v = bool(*i);
-        else bad_value(owner_, s, text);
+        else bad_value(owner_, s, given);
       }
       break;
     case ParamType::Enum: {
       auto str = std::get_if<std::string>(&value);
-      if (!str) bad_value(owner_, s, text);
+      if (!str) bad_value(owner_, s, given);
       bool ok = false;
       for (const auto& c : s.choices) ok = ok || c == *str;
-      if (!ok) out_of_range(owner_, s, "'" + *str + "'");
+      if (!ok) out_of_range(owner_, s, given);
       break;
     }
   }
@@ -150,38 +203,39 @@ void ParamSet::set(const std::string& name, const ParamValue& value) {
 
 void ParamSet::set_text(const std::string& name, const std::string& text) {
   const ParamSpec& s = spec(name);
+  const std::string given = quoted(text);  // every message repeats what was typed, verbatim
   switch (s.type) {
     case ParamType::Int: {
       errno = 0;
       char* end = nullptr;
       long long i = std::strtoll(text.c_str(), &end, 10);
       if (text.empty() || *end != '\0' || errno == ERANGE) {
-        // Accept "5.0" style integers but nothing fractional.
+        // "5.0" and "1e3" are whole numbers too; "1e20" or twenty digits is out of range.
         char* dend = nullptr;
         double d = std::strtod(text.c_str(), &dend);
-        if (text.empty() || *dend != '\0') bad_value(owner_, s, text);
-        set(name, d);
+        if (text.empty() || *dend != '\0') bad_value(owner_, s, given);
+        set_checked(name, d, given);
         return;
       }
-      set(name, std::int64_t(i));
+      set_checked(name, std::int64_t(i), given);
       return;
     }
     case ParamType::Float: {
       char* end = nullptr;
       double d = std::strtod(text.c_str(), &end);
-      if (text.empty() || *end != '\0') bad_value(owner_, s, text);
-      set(name, d);
+      if (text.empty() || *end != '\0') bad_value(owner_, s, given);
+      set_checked(name, d, given);
       return;
     }
     case ParamType::Bool: {
       std::string t;
       for (char c : text) t += char(std::tolower(static_cast<unsigned char>(c)));
-      if (t == "1" || t == "true" || t == "on" || t == "yes") set(name, true);
-      else if (t == "0" || t == "false" || t == "off" || t == "no") set(name, false);
-      else bad_value(owner_, s, text);
+      if (t == "1" || t == "true" || t == "on" || t == "yes") set_checked(name, true, given);
+      else if (t == "0" || t == "false" || t == "off" || t == "no") set_checked(name, false, given);
+      else bad_value(owner_, s, given);
       return;
     }
-    case ParamType::Enum: set(name, text); return;
+    case ParamType::Enum: set_checked(name, text, given); return;
   }
 }
 

@@ -39,7 +39,8 @@ class ParamSet {
   ParamSet(std::string owner, const ParamTable* table);
 
   void set(const std::string& name, const ParamValue& value);
-  void set_text(const std::string& name, const std::string& text);  // parses by the spec's type
+  // Parses by the spec's type; an error repeats `text` as given.
+  void set_text(const std::string& name, const std::string& text);
   bool has(const std::string& name) const;
   // True when a setter gave this parameter a value (for the unused-setting report).
   bool was_set(const std::string& name) const { return given_.count(name) != 0; }
@@ -52,6 +53,8 @@ class ParamSet {
 
  private:
   const ParamSpec& spec(const std::string& name) const;
+  // set() with `given`, what the caller gave as messages show it.
+  void set_checked(const std::string& name, const ParamValue& value, const std::string& given);
   std::string owner_;
   const ParamTable* table_ = nullptr;
   std::map<std::string, ParamValue> values_;
@@ -63,8 +66,11 @@ class ParamSet {
 void report_unused(const ParamSet& params, const std::string& name, const std::string& why,
                    std::vector<std::string>& out);
 
+// The fewest %g digits that read back as v: "0.1", "1e+20", "inf".
+std::string number_text(double v);
 std::string param_value_text(const ParamValue& v);  // "5", "0.25", "true", "gaussian"
-// "[0, 64]" for numbers, "one of: a, b" for enums, "" for bools.
+// "[0, 64]" for numbers (">= 0 (no upper bound)" when a bound is infinite or the type's
+// end), "one of: a, b" for enums, "" for bools.
 std::string param_range_text(const ParamSpec& s);
 
 }  // namespace mcr

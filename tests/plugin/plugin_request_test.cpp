@@ -86,6 +86,26 @@ TEST(PluginRequest, BadSwitchValuesNameTheSettingAndTheText) {
   }
 }
 
+// The output side's compression is checked when the request is made (OIIO would silently
+// write zip for a name it does not know), with the CLI's check and message.
+TEST(PluginRequest, CompressionIsCheckedOnTheOutputSide) {
+  EXPECT_EQ(make_request("o.exr", {{"filter", "box"}, {"compression", "PIZ"}}, true).compression, "piz");
+  EXPECT_EQ(make_request("o.exr", {{"filter", "box"}, {"compression", "dwaa:45"}}, true).compression, "dwaa:45");
+  EXPECT_EQ(make_request("o.exr", {{"filter", "box"}}, true).compression, "zip");
+  for (const char* c : {"bogus", "zip:0", "", "piz:2"}) {
+    try {
+      make_request("o.exr", {{"filter", "box"}, {"compression", c}}, true);
+      ADD_FAILURE() << "compression=" << c << " accepted";
+    } catch (const Error& e) {
+      EXPECT_EQ(e.code(), Errc::InvalidArgument);
+      EXPECT_NE(std::string(e.what()).find("compression '" + std::string(c) + "'"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("zip, zips, piz"), std::string::npos) << e.what();
+    }
+  }
+  // On the input side compression is no setting of the plugin: a filter parameter, refused there.
+  EXPECT_EQ(make_request("x.exr", {{"filter", "box"}, {"compression", "bogus"}}, false).params.size(), 1u);
+}
+
 TEST(PluginRequest, NotesTextJoinsTheNotes) {
   EXPECT_EQ(notes_text({}), "");
   EXPECT_EQ(notes_text({"a has no effect", "b"}), "a has no effect; b");

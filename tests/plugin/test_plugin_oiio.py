@@ -401,10 +401,41 @@ class TestErrors(PluginTestBase):
                                 "3", "-o:fileformatname=mcrecon", self.path("o.exr"))
 
     def test_bad_parameter_values(self):
-        for value in ("abc", "1000", "-1", "2.5"):
+        for value in ("abc", "1000", "-1", "2.5", "1e20", "100000000000000000000"):
             with self.subTest(value=value):
                 self.expect_cli_message(["-f", "box", "--set", "radius=" + value],
                                         ROOM + ".mcrecon?filter=box&radius=" + value, "-o", self.path("o.exr"))
+
+    def test_typed_numbers_are_printed_readably(self):
+        """An --iconfig float arrives as a number: the message shows it as the CLI would show
+        that text, never a reformatted double with 9 digits or 300 of DBL_MAX."""
+        line = self.expect_cli_message(["-f", "box", "--set", "radius=1e+20"],
+                                       "--iconfig", "mcrecon:filter", "box", "--iconfig:type=float", "mcrecon:radius",
+                                       "1e20", ROOM + ".mcrecon", "-o", self.path("o.exr"))
+        self.assertIn("'1e+20'", line)
+        self.assertIn("[0, 64]", line)
+        self.expect_cli_message(["-f", "box", "--set", "clamp=-0.5"],
+                                "--iconfig", "mcrecon:filter", "box", "--iconfig:type=float", "mcrecon:clamp", "-0.5",
+                                ROOM + ".mcrecon", "-o", self.path("o.exr"))
+
+    def test_bad_compression_on_the_output_plugin(self):
+        cli = tu.run_cli("denoise", ROOM, "-o", self.path("cli.exr"), "-f", "box", "--compression", "bogus",
+                         check=False)
+        self.assertEqual(cli.returncode, 2, cli.stderr)
+        line = cli_error_line(cli)
+        self.assertIn("compression 'bogus'", line)
+        self.assertIn("none, rle, zip, zips, piz, pxr24, b44, b44a, dwaa, dwab", line)
+        out = self.path("o.exr")
+        proc = oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "--attrib", "mcrecon:compression", "bogus",
+                        "-o:fileformatname=mcrecon", out, timeout=60)
+        self.assertNotEqual(proc.returncode, 0)
+        self.assertIn(line, proc.stdout + proc.stderr)
+        self.assertFalse(os.path.exists(out))
+        self.assertEqual([n for n in os.listdir(self.tmp) if n != "cli.exr"], [])
+        # A valid one reaches the file.
+        check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "--attrib", "mcrecon:compression", "piz",
+                          "-o:fileformatname=mcrecon", out))
+        self.assertEqual(header_attribute(out, "compression"), "piz")
 
     def test_missing_passes(self):
         line = self.expect_cli_message(["-f", "box", "--pass", "normal=NoSuchGroup"],

@@ -354,6 +354,75 @@ class CliErrorTest(_TempDirCase):
         self.assert_user_error(["nosuchcommand"], [])
         self.assert_user_error(["denoise", self.ml], [])  # -o and -f missing
 
+    # -------------------------------------------------------------- bad values, readable messages
+
+    def box_range(self, name):
+        """'[min, max]' of a box parameter, from `mcrecon filters --json` (ints as ints)."""
+        box = [f for f in tu.run_cli_json("filters", "--json")["filters"] if f["name"] == "box"][0]
+        p = [p for p in box["parameters"] if p["name"] == name][0]
+        fmt = (lambda v: "%d" % v) if p["type"] == "int" else (lambda v: "%g" % v)
+        return "[%s, %s]" % (fmt(p["min"]), fmt(p["max"]))
+
+    def test_unknown_compression_is_refused(self):
+        for c in ("bogus", "zip:0", "zip:10", "piz:3", "dwaa:-1", ""):
+            proc = self.assert_user_error(self.denoise(self.ml, "--compression", c), ["compression '%s'" % c])
+            self.assertIn("none, rle, zip, zips, piz, pxr24, b44, b44a, dwaa, dwab", proc.stderr)
+
+    def test_output_must_be_an_exr_name(self):
+        for name in ("out.xyz", "out.png", "out", "out.exr.bak"):
+            out = os.path.join(self.out, name)
+            self.assert_user_error(self.denoise(self.ml, out=out),
+                                   ["output '%s': mcrecon writes OpenEXR; use a .exr name" % out])
+        pattern = os.path.join(self.seq_dir, "shot_####.exr")
+        out = os.path.join(self.out, "o_####.tif")
+        self.assert_user_error(["denoise", pattern, "--frames", "1-2", "-o", out, "-f", "box"],
+                               ["output '%s'" % out, "use a .exr name"])
+        out = os.path.join(self.out, "sparse.xyz")
+        self.assert_user_error(["sparsify", self.ml, "-o", out], ["output '%s'" % out, "use a .exr name"])
+
+    def test_demo_spp_level_the_samples_lack(self):
+        samples = os.path.join(tu.source_dir(), "samples", "data")
+        with open(os.path.join(samples, "manifest.json")) as f:
+            manifest = json.load(f)
+        scenes = manifest["scenes"] if isinstance(manifest, dict) else manifest
+        levels = sorted({int(k) for s in scenes for k in s["noisy"]})
+        out = os.path.join(self.out, "demo")
+        for spp in ("3", "2048"):
+            self.assert_user_error(["demo", "--samples", samples, "--spp", spp, "--out", out],
+                                   ["--spp %s" % spp, ", ".join(map(str, levels))])
+        self.assert_user_error(["demo", "--samples", samples, "--spp", "16", "3", "--out", out], ["--spp 3"])
+        for spp in ("x", "0", "-4"):
+            self.assert_user_error(["demo", "--samples", samples, "--spp", spp, "--out", out], ["--spp", "'%s'" % spp])
+
+    def test_region_not_inside_the_image(self):
+        for region in ("30,0,40,10", "0,0,32,25", "40,40,50,50", "0,23,32,25"):
+            self.assert_user_error(self.denoise(self.ml, "--region", region),
+                                   ["region %s is outside the %dx%d image (x in [0, %d), y in [0, %d))"
+                                    % (region, W, H, W, H)])
+
+    def test_parameter_messages_repeat_the_typed_text(self):
+        rng = self.box_range("radius")
+        for v in ("100000000000000000000", "1e20", "1E20", "65.0"):
+            proc = self.assert_user_error(self.denoise(self.ml, "--set", "radius=" + v),
+                                          ["'radius'", "'%s'" % v, rng])
+            self.assertNotIn("e+20", proc.stderr)
+        proc = self.assert_user_error(self.denoise(self.ml, "--set", "clamp=1e31"), ["'clamp'", "'1e31'", "[0, 1e+30]"])
+        self.assertLess(len(proc.stderr), 300, proc.stderr)
+
+    def test_command_line_errors_name_what_was_typed(self):
+        commands = "commands: info, filters, denoise, compare, sparsify, demo"
+        self.assert_user_error(["frobnicate"], ["unknown command 'frobnicate'; " + commands])
+        self.assert_user_error(["frobnicate", "--filter", "box"], ["unknown command 'frobnicate'"])
+        self.assert_user_error([], ["no command given; " + commands])
+        for bad in ("abc", "-1", "99999999999", "1.5"):
+            proc = self.assert_user_error(self.denoise(self.ml, "--threads", bad),
+                                          ["--threads", "'%s'" % bad, "[0, 2147483647]"])
+            self.assertNotIn("1797693", proc.stderr)
+        self.assert_user_error(["sparsify", self.ml, "-o", os.path.join(self.out, "s.exr"), "--density", "5"],
+                               ["--density", "'5'", "[0.0001, 1]"])
+        self.assert_user_error(self.denoise(self.ml, "--nosuch-option"), ["--nosuch-option"])
+        self.assert_user_error(self.denoise(self.ml, "--set"), ["--set"])
+
 
 class CliDenoiseTest(_TempDirCase):
     def test_box_writes_rgba_float_with_input_alpha(self):
@@ -370,6 +439,15 @@ class CliDenoiseTest(_TempDirCase):
         np.testing.assert_allclose(px[:, :, :3], want, rtol=1e-6, atol=0)
         np.testing.assert_array_equal(px[:, :, 3], self.ml_pixels[:, :, 3])
         self.assertEqual(spec.get_string_attribute("mcreconFilter"), "box")
+
+    def test_compression_is_written_as_asked(self):
+        for c, want in (("piz", "piz"), ("ZIPS", "zips"), ("zip:9", "zip"), ("dwaa:45", "dwaa"), ("none", "none")):
+            out = os.path.join(self.out, "c.exr")
+            proc = self.run_cli("denoise", self.ml, "-o", out, "-f", "box", "--compression", c)
+            self.assertEqual(proc.returncode, 0, proc.stderr)
+            self.assertEqual(image_spec_and_pixels(out)[0].get_string_attribute("compression"), want, c)
+        out = os.path.join(self.out, "upper.EXR")  # any case of .exr
+        self.assertEqual(self.run_cli("denoise", self.ml, "-o", out, "-f", "box").returncode, 0)
 
     def test_radius_zero_is_identity(self):
         out = os.path.join(self.out, "same.exr")
@@ -494,6 +572,27 @@ class CliSequenceTest(_TempDirCase):
             self.assertNotIn("skip " + o, proc.stderr)
             self.assertEqual(image_spec_and_pixels(o)[0].nchannels, 4)
         self.assertIn("2 written, 2 already done", proc.stderr)
+
+    def test_resume_redoes_a_truncated_output(self):
+        d = self.make_sequence(3, 16, 12)
+        args = ["denoise", os.path.join(d, "shot_####.exr"), "--frames", "1-3",
+                "-o", os.path.join(self.out, "out_####.exr"), "-f", "box"]
+        self.assertEqual(self.run_cli(*args).returncode, 0)
+        outs = [os.path.join(self.out, "out_%04d.exr" % f) for f in (1, 2, 3)]
+        _, want = image_spec_and_pixels(outs[1])
+        with open(outs[1], "rb") as f:
+            data = f.read()
+        with open(outs[1], "wb") as f:  # what a SIGKILL or a full disk might leave
+            f.write(data[:len(data) // 2])
+        before = os.stat(outs[0])
+        proc = self.run_cli(*args, "--resume")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        self.assertIn("redo %s (unreadable: " % outs[1], proc.stderr)
+        self.assertIn("1 written, 2 already done", proc.stderr)
+        np.testing.assert_array_equal(image_spec_and_pixels(outs[1])[1], want)  # complete again
+        st = os.stat(outs[0])
+        self.assertEqual((st.st_ino, st.st_mtime_ns), (before.st_ino, before.st_mtime_ns))
+        self.assertEqual(temp_files(self.out), [])
 
     def test_printf_pattern(self):
         d = self.make_sequence(2, 8, 8)

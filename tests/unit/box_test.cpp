@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "expect_error.h"
 #include "feature_filter_testutil.h"
 #include "filters/registry.h"
 #include "util/error.h"
@@ -213,13 +214,17 @@ TEST(BoxFilterTest, RegionChangesOnlyPixelsInside) {
   testutil::expect_only_region_changed(run_box(in, r, 0, roi), run_box(in, r), in, roi);
 }
 
-TEST(BoxFilterTest, RegionIsClippedToTheImage) {
+// A region reaching outside the image is refused, not clipped (issue 13: a typo in
+// --region must not filter a different region silently); the whole image as a region is fine.
+TEST(BoxFilterTest, RegionOutsideTheImageIsRefused) {
   const Image in = random_image(10, 8, 9);
-  const Image out = run_box(in, 1, 0, Roi{-5, 4, 100, 100});
+  testutil::expect_error(Errc::InvalidArgument, {"region -5,4,100,100", "10x8"},
+                         [&] { run_box(in, 1, 0, Roi{-5, 4, 100, 100}); });
+  const Image out = run_box(in, 1, 0, Roi{0, 0, 10, 8});
   const Image full = run_box(in, 1);
   for (int y = 0; y < 8; ++y)
     for (int x = 0; x < 10; ++x)
-      for (int c = 0; c < 3; ++c) ASSERT_EQ(out.at(x, y, c), y >= 4 ? full.at(x, y, c) : in.at(x, y, c));
+      for (int c = 0; c < 3; ++c) ASSERT_EQ(out.at(x, y, c), full.at(x, y, c));
 }
 
 TEST(BoxFilterTest, ExtraColourChannelsAreDroppedAndAlphaIsNotAveraged) {

@@ -8,6 +8,7 @@
 #include <limits>
 #include <random>
 
+#include "expect_error.h"
 #include "filters/registry.h"
 
 namespace mcr {
@@ -160,23 +161,35 @@ TEST(FilterStress, ZeroAlbedoWithDemodulation) {
   }
 }
 
-TEST(FilterStress, RegionOutsideTheFrameKeepsTheInput) {
-  // An empty region filters nothing: the colour comes back as rendered, not demodulated or
-  // firefly-suppressed.
+// A region not entirely inside the frame (or empty) is refused, naming the region and the
+// image's extent: clipping it silently hid a typo (issue 13). The whole frame given as a
+// region is the whole frame.
+TEST(FilterStress, RegionNotInsideTheFrameIsRefused) {
+  const Frame f = full_frame(18, 13, 7);
   for (const std::string& name : filter_names()) {
-    if (make_filter(name)->info().temporal) continue;
-    const Frame f = full_frame(18, 13, 7);
+    SCOPED_TRACE(name);
     auto filter = make_filter(name);
-    filter->set("demodulate", true);
-    filter->set("firefly_k", 2.0);
     filter->commit();
-    ExecOptions o;
-    o.roi = Roi{40, 40, 50, 50};
-    const Image out = filter->execute(f, o);
-    const Image& in = f.image(Role::Colour);
+    for (const Roi& r : {Roi{40, 40, 50, 50}, Roi{10, 5, 19, 8}, Roi{0, 0, 18, 14}, Roi{-1, 0, 5, 5},
+                         Roi{5, 5, 5, 9}, Roi{6, 4, 2, 9}}) {
+      ExecOptions o;
+      o.roi = r;
+      const std::string text = std::to_string(r.x0) + "," + std::to_string(r.y0) + "," + std::to_string(r.x1) +
+                               "," + std::to_string(r.y1);
+      const std::string msg = testutil::expect_error(Errc::InvalidArgument, [&] { filter->execute(f, o); });
+      EXPECT_NE(msg.find("region " + text), std::string::npos) << msg;
+      if (!r.empty()) EXPECT_NE(msg.find("outside the 18x13 image (x in [0, 18), y in [0, 13))"), std::string::npos) << msg;
+      else EXPECT_NE(msg.find("empty"), std::string::npos) << msg;
+    }
+    ExecOptions whole;
+    whole.roi = Roi{0, 0, 18, 13};
+    const Image a = filter->execute(f, whole);
+    auto fresh = make_filter(name);
+    fresh->commit();
+    const Image b = fresh->execute(f);
     for (int y = 0; y < f.height; ++y)
       for (int x = 0; x < f.width; ++x)
-        for (int c = 0; c < 3; ++c) ASSERT_EQ(out.at(x, y, c), in.at(x, y, c)) << name << " at " << x << "," << y;
+        for (int c = 0; c < 3; ++c) ASSERT_EQ(a.at(x, y, c), b.at(x, y, c)) << x << "," << y;
   }
 }
 

@@ -130,6 +130,74 @@ TEST(ParamsTest, BadValuesNameParameterTypeAndText) {
   expect_error(Errc::BadParameterValue, [&] { p.set_text("albedo", "2"); });
 }
 
+// Issue 13: the message repeats what the user typed, verbatim, never a reformatted double.
+TEST(ParamsTest, MessagesRepeatTheTypedText) {
+  ParamSet p = params();
+  for (const char* t : {"1e20", "100000000000000000000", "1E20", "65.0", "-0.5e1"}) {
+    const std::string msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("radius", t); });
+    EXPECT_TRUE(contains(msg, "'" + std::string(t) + "'")) << msg;
+    EXPECT_TRUE(contains(msg, "[0, 64]")) << msg;
+    EXPECT_FALSE(contains(msg, "e+20")) << msg;
+  }
+  for (const char* t : {"1e999", "-1e999", "2.50", "0x"}) {
+    const std::string msg = expect_error(Errc::BadParameterValue, [&] { p.set_text("radius", t); });
+    EXPECT_TRUE(contains(msg, "'" + std::string(t) + "'")) << msg;
+    EXPECT_TRUE(contains(msg, "[0, 64]")) << msg;  // the valid range, also for a type error
+  }
+  for (const char* t : {"1e999", "1.0e+400", "NaN"}) {
+    const std::string msg = expect_error(Errc::BadParameterValue, [&] { p.set_text("sigma", t); });
+    EXPECT_TRUE(contains(msg, "'" + std::string(t) + "'")) << msg;
+    EXPECT_FALSE(contains(msg, "'inf'")) << msg;
+  }
+  std::string msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("sigma", "0.0010"); });
+  EXPECT_TRUE(contains(msg, "'0.0010'")) << msg;
+  EXPECT_TRUE(contains(msg, "[0.01, 10]")) << msg;
+  msg = expect_error(Errc::BadParameterValue, [&] { p.set_text("albedo", "Maybe"); });
+  EXPECT_TRUE(contains(msg, "'Maybe'")) << msg;
+  EXPECT_TRUE(contains(msg, "true")) << msg;  // the accepted spellings
+  // A typed value (Python, an OIIO float attribute) has no text: printed readably, unquoted.
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set("radius", 1e20); });
+  EXPECT_TRUE(contains(msg, "got 1e+20")) << msg;
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set("sigma", 0.1 + 10.0); });
+  EXPECT_TRUE(contains(msg, "got 10.1")) << msg;  // the shortest text that reads back, not 10.0999999
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set("radius", std::int64_t(-3)); });
+  EXPECT_TRUE(contains(msg, "got -3")) << msg;
+}
+
+// Ranges print readably: shortest digits, and an infinite or type-end bound as "no bound"
+// instead of 300 digits of DBL_MAX.
+TEST(ParamsTest, RangesPrintReadably) {
+  const double inf = std::numeric_limits<double>::infinity(), big = std::numeric_limits<double>::max();
+  const auto i64max = std::numeric_limits<std::int64_t>::max();
+  static const ParamTable t = {
+      ParamSpec::Float("clamp", 0.0, 0.0, 1e30, ""),
+      ParamSpec::Float("gain", 1.0, 0.0, big, ""),
+      ParamSpec::Float("offset", 0.0, -inf, 5.0, ""),
+      ParamSpec::Float("any", 0.0, -big, inf, ""),
+      ParamSpec::Int("count", 1, 1, i64max, ""),
+      ParamSpec::Float("tenth", 0.5, 0.1, 0.3, ""),
+  };
+  EXPECT_EQ(param_range_text(t[0]), "[0, 1e+30]");
+  EXPECT_EQ(param_range_text(t[1]), ">= 0 (no upper bound)");
+  EXPECT_EQ(param_range_text(t[2]), "<= 5 (no lower bound)");
+  EXPECT_EQ(param_range_text(t[3]), "any number");
+  EXPECT_EQ(param_range_text(t[4]), ">= 1 (no upper bound)");
+  EXPECT_EQ(param_range_text(t[5]), "[0.1, 0.3]");
+  ParamSet p("ranges", &t);
+  std::string msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("gain", "-1"); });
+  EXPECT_TRUE(contains(msg, "must be >= 0 (no upper bound), got '-1'")) << msg;
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("count", "0"); });
+  EXPECT_TRUE(contains(msg, ">= 1 (no upper bound)")) << msg;
+  p.set_text("count", "9223372036854775807");
+  EXPECT_EQ(p.get_int("count"), i64max);
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("count", "1e19"); });
+  EXPECT_TRUE(contains(msg, "'1e19'")) << msg;
+  msg = expect_error(Errc::ParameterOutOfRange, [&] { p.set_text("clamp", "2e30"); });
+  EXPECT_TRUE(contains(msg, "must be in [0, 1e+30], got '2e30'")) << msg;
+  EXPECT_LT(msg.size(), 120u) << msg;
+  for (const std::string& m : {msg, param_range_text(t[1])}) EXPECT_EQ(m.find("1797"), std::string::npos) << m;
+}
+
 TEST(ParamsTest, TypedSetChecksTheType) {
   ParamSet p = params();
   expect_error(Errc::BadParameterValue, [&] { p.set("radius", std::string("3")); });
@@ -171,6 +239,10 @@ TEST(ParamsTest, GetterOfTheWrongTypeIsATypedError) {
 TEST(ParamsTest, TextForms) {
   EXPECT_EQ(param_value_text(ParamValue(std::int64_t(5))), "5");
   EXPECT_EQ(param_value_text(ParamValue(0.25)), "0.25");
+  EXPECT_EQ(param_value_text(ParamValue(0.1)), "0.1");
+  EXPECT_EQ(param_value_text(ParamValue(1.0 / 3.0)), "0.3333333333333333");  // reads back exactly
+  EXPECT_EQ(param_value_text(ParamValue(1e20)), "1e+20");
+  EXPECT_EQ(number_text(std::numeric_limits<double>::infinity()), "inf");
   EXPECT_EQ(param_value_text(ParamValue(true)), "true");
   EXPECT_EQ(param_value_text(ParamValue(std::string("gauss"))), "gauss");
   EXPECT_EQ(param_range_text(table()[0]), "[0, 64]");
