@@ -45,7 +45,7 @@ struct PassNeeds {
 void check_passes(const PassNeeds& need, const Frame& frame, const std::string& who);
 
 struct ExecOptions {
-  Roi roi;           // empty = whole frame; pixels outside keep the input colour
+  Roi roi;           // {} = whole frame; any other roi must lie inside it; pixels outside keep the input colour
   int nthreads = 0;  // 0 = all cores
 };
 

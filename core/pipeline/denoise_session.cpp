@@ -3,8 +3,8 @@
 #include <chrono>
 #include <filesystem>
 
+#include "io/exr_output.h"
 #include "io/output_guard.h"
-
 #include "util/error.h"
 
 namespace mcr {
@@ -37,6 +37,8 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
       if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
     }
     check_output_path(output, inputs);
+    check_exr_name(output);  // Python and the add-on too: never EXR data under another name
+    checked_exr_compression(write.compression);
   }
   StageTimes t;
   auto t0 = std::chrono::steady_clock::now();
