@@ -3,6 +3,9 @@
 #   bash setup.sh          install + build
 #   bash setup.sh demo     install + build + run the demo on the embedded sample scenes
 #   bash setup.sh test     install + build + run every test (ctest)
+#   bash setup.sh sanitize install + an ASan+UBSan clang build in build-asan (with the libFuzzer
+#                          targets) + its ctest: unit, CLI, plugin and Python module tests under the
+#                          sanitizers, a short run of every fuzz target (no Blender, no benchmarks)
 set -euo pipefail
 cd "$(dirname "$0")"
 BUILD_DIR=${BUILD_DIR:-build}
@@ -16,6 +19,7 @@ PACKAGES=(
   libgtest-dev libbenchmark-dev
   pybind11-dev python3-pybind11 python3-numpy
   blender
+  clang libclang-rt-14-dev libfuzzer-14-dev llvm-14
 )
 
 missing=()
@@ -29,6 +33,17 @@ if ((${#missing[@]})); then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${missing[@]}"
 fi
 
+if [ "${1:-build}" = sanitize ]; then
+  # Its own build directory: another compiler and flags (README, "Sanitizers and fuzzing").
+  SAN_DIR=${SAN_BUILD_DIR:-build-asan}
+  cmake -S . -B "$SAN_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DCMAKE_CXX_COMPILER=clang++ \
+    -DMCRECON_SANITIZE=address,undefined -DMCRECON_FUZZ=ON -DMCRECON_BUILD_BENCH=OFF \
+    -DPython3_EXECUTABLE=/usr/bin/python3
+  cmake --build "$SAN_DIR" -j "$JOBS"
+  ctest --test-dir "$SAN_DIR" --output-on-failure -j "$JOBS"
+  exit 0
+fi
+
 cmake -S . -B "$BUILD_DIR" -G Ninja -DCMAKE_BUILD_TYPE=Release -DPython3_EXECUTABLE=/usr/bin/python3
 cmake --build "$BUILD_DIR" -j "$JOBS"
 
@@ -36,5 +51,5 @@ case "${1:-build}" in
   build) ;;
   demo) shift; "$BUILD_DIR/bin/mcrecon" demo --out "${DEMO_OUT:-demo_out}" "$@" ;;
   test) ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" ;;
-  *) echo "setup: unknown action '$1' (use build, demo or test)" >&2; exit 2 ;;
+  *) echo "setup: unknown action '$1' (use build, demo, test or sanitize)" >&2; exit 2 ;;
 esac
