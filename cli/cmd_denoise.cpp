@@ -51,7 +51,6 @@ int run_denoise(const DenoiseArgs& a) {
   std::vector<std::pair<std::string, std::string>> params;
   for (const auto& s : a.sets) params.push_back(parse_key_value(s, "--set"));
   DenoiseSession session(a.filter, params, a.accumulate);  // unknown filter / parameter errors first
-  check_exr_name(a.output);
 
   ReadOptions ro;
   ro.layer = a.layer;
@@ -99,6 +98,7 @@ int run_denoise(const DenoiseArgs& a) {
   for (const auto& j : jobs) outputs.push_back(j.second);
   if (seq) check_sequence_outputs(a.output, parse_frame_range(a.frames), inputs);  // every frame its own file
   else check_output_paths(outputs, inputs);
+  check_exr_name(a.output);  // after the guard: a device or an input is the graver fault to name
 
   const bool temporal = session.reconstruction().temporal();
   // Settings that change nothing: said once, not per frame.

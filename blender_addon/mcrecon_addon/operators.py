@@ -47,7 +47,7 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
         seq = "#" in src
         frames = list(range(self.frame_start, self.frame_end + 1)) if seq else [None]
         if seq and "#" not in out:
-            self.report({"ERROR"}, "mcrecon: the output must contain #### for a sequence input")
+            self.report({"ERROR"}, "mcrecon: output '%s' must contain #### for the sequence input '%s'" % (out, src))
             return {"CANCELLED"}
         if not frames:
             self.report({"ERROR"}, f"mcrecon: empty frame range {self.frame_start}-{self.frame_end}")

@@ -482,8 +482,10 @@ PYBIND11_MODULE(mcrecon, m) {
          const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
          const std::optional<std::function<void(std::int64_t, std::int64_t, std::string)>>& progress, const py::object& accumulate) {
         const int first = int_from_py("first", first_arg), last = int_from_py("last", last_arg);
-        if (!mcr::is_sequence_pattern(input) || !mcr::is_sequence_pattern(output))
-          throw mcr::Error(Errc::InvalidArgument, "input and output must be sequence patterns (#### or %04d)");
+        for (const std::string* p : {&input, &output})
+          if (!mcr::is_sequence_pattern(*p))
+            throw mcr::Error(Errc::InvalidArgument, std::string(p == &input ? "input" : "output") + " '" + *p +
+                                                        "' must be a sequence pattern (#### or %04d)");
         if (last < first) throw mcr::Error(Errc::InvalidArgument, "frame range " + std::to_string(first) + "-" +
                                                                         std::to_string(last) + " is empty");
         // Every input, and every output against them all, checked before the first frame is

@@ -157,16 +157,16 @@ def driver_main():
                BLENDER_USER_SCRIPTS=os.path.join(root, "scripts"))
     cmd = [blender, "-b", "--factory-startup", "--python-exit-code", "1", "--python", os.path.abspath(__file__),
            "--", plan_path]
-    n = len(OPERATOR_CASES) + len(RENDER_CASES)
+    n_cases = len(OPERATOR_CASES) + len(RENDER_CASES)
     try:
-        p = subprocess.run(cmd, capture_output=True, text=True, timeout=10 * n + 30, env=env,
+        p = subprocess.run(cmd, capture_output=True, text=True, timeout=10 * n_cases + 30, env=env,
                            stdin=subprocess.DEVNULL)
     except subprocess.TimeoutExpired as e:
         out = (e.stdout or b"").decode(errors="replace") if isinstance(e.stdout, bytes) else (e.stdout or "")
         started = [l for l in out.splitlines() if l.startswith("=== case")]
         print(out[-4000:])
         print("FAIL: Blender did not finish within %d s; last case started: %s"
-              % (10 * n + 30, started[-1] if started else "none"))
+              % (10 * n_cases + 30, started[-1] if started else "none"))
         sys.exit(1)
     log = p.stdout + p.stderr
     with open(os.path.join(root, "blender.log"), "w") as f:
@@ -245,7 +245,7 @@ def driver_main():
         print("(Blender log: %s)" % os.path.join(root, "blender.log"))
         sys.exit(1)
     shutil.rmtree(root, ignore_errors=True)
-    print("OK: %d add-on cases" % n)
+    print("OK: %d add-on cases" % n_cases)
 
 
 def _in_blender():

@@ -274,7 +274,7 @@ def _cases():
         mentions=["spatial_sigma", ("1e20", "1e+20")], note="echoed as 1e+20 (issue 9)",
         mentions_fe={"cli": ["spatial_sigma", "1e20"], "oiio_read": ["spatial_sigma", "1e20"]})
     add("py_parameter_int_beyond_int64", dict(py=lambda c: "mcrecon.Session('box', {'radius': 10**30})"),
-        mentions=["radius"], note="bare RuntimeError 'Unable to cast Python instance' (issue 9)")
+        mentions=["radius", str(10**30)], note="bare RuntimeError 'Unable to cast Python instance' (issue 9)")
     add("non_numeric_parameter", param_fe("radius=abc", "", "{'radius': 'abc'}"), mentions=["radius", "abc"])
     add("nan_parameter", param_fe("radius=nan", "", "{'radius': float('nan')}"), mentions=["radius", "nan"])
     add("compression_bogus",

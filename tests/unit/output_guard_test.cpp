@@ -119,7 +119,8 @@ TEST(OutputGuard, OnlyRegularFilesOrNewPathsAreWritten) {
   const std::pair<std::string, std::string> cases[] = {{node, "character device"}, {fifo, "FIFO"}, {sock, "socket"},
                                                        {dir.path("sub"), "directory"},
                                                        {dir.path("link_to_null"), "character device"}};
-  for (const auto& [target, kind] : cases) {
+  for (const auto& c : cases) {
+    const std::string &target = c.first, &kind = c.second;  // named copies: lambdas cannot capture bindings
     for (const std::string& msg :
          {expect_error(Errc::WriteFailed, [&] { check_output_path(target, {}); }),
           expect_error(Errc::WriteFailed, [&] { write_atomic(img, target, "openexr"); }),
@@ -148,7 +149,8 @@ TEST(OutputGuard, DenoiseSessionNeverWritesOverAnInput) {
   const std::pair<std::string, std::string> cases[] = {
       {dir.path("in.exr"), "in.exr"},      {dir.path("./in.exr"), "in.exr"}, {dir.path("sub/../in.exr"), "in.exr"},
       {dir.path("link.exr"), "link.exr"}, {dir.path("hard.exr"), "hard.exr"}};
-  for (const auto& [output, named] : cases) {
+  for (const auto& c : cases) {
+    const std::string &output = c.first, &named = c.second;
     const std::string msg =
         expect_error(Errc::InvalidArgument, [&] { session.run(dir.path("in.exr"), output, {}, {}, {}); });
     EXPECT_TRUE(contains(msg, named) && contains(msg, "never overwritten")) << msg;
