@@ -141,6 +141,21 @@ std::string dims(std::int64_t w, std::int64_t h, std::int64_t c) {
   return std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c) + " float";
 }
 
+// A name from a file as a message shows it: bytes outside printable ASCII as \xNN.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (unsigned char c : s) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += char(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    }
+  }
+  return out;
+}
+
 // An OpenEXR header read in order from its file, never past the file's end.
 class ExrHeaderReader {
  public:
@@ -155,10 +170,10 @@ class ExrHeaderReader {
     for (;;) {
       const int c = file_.get();
       if (c == std::char_traits<char>::eof())
-        fail(what + (s.empty() ? "" : " '" + s + "'") + " has no terminator: the file ends inside it (truncated?)");
+        fail(what + (s.empty() ? "" : " '" + printable(s) + "'") + " has no terminator: the file ends inside it (truncated?)");
       ++pos_;
       if (c == 0) return s;
-      if (s.size() == 255) fail(what + " '" + s.substr(0, 32) + "...' is longer than 255 bytes");
+      if (s.size() == 255) fail(what + " '" + printable(s.substr(0, 32)) + "...' is longer than 255 bytes");
       s += char(c);
     }
   }
@@ -205,42 +220,69 @@ std::string exr_compression_name(int c) {
   return c >= 0 && c < 10 ? names[c] : "unknown";
 }
 
-// Reads one attribute's value (the reader stands at its start, `size` bytes that
-// the file holds) into `part` where the tile checks need it, and refuses a value
-// whose contents claim more than `size`: OpenEXR allocates those claims first.
+// The bytes OpenEXR reads for a value of a fixed-size type, whatever size the header
+// declares (0: not such a type).
+std::uint64_t exr_fixed_size(const std::string& type) {
+  static const std::pair<const char*, int> sizes[] = {
+      {"box2i", 16},  {"box2f", 16},   {"compression", 1}, {"chromaticities", 32}, {"deepImageState", 1},
+      {"double", 8},  {"envmap", 1},   {"float", 4},       {"int", 4},             {"keycode", 28},
+      {"lineOrder", 1}, {"m33d", 72},  {"m33f", 36},       {"m44d", 128},          {"m44f", 64},
+      {"rational", 8}, {"tiledesc", 9}, {"timecode", 8},   {"v2d", 16},            {"v2f", 8},
+      {"v2i", 8},     {"v3d", 24},     {"v3f", 12},        {"v3i", 12}};
+  for (const auto& [t, n] : sizes)
+    if (type == t) return std::uint64_t(n);
+  return 0;
+}
+
+// Reads one attribute's value (the reader stands at its start; the file holds the
+// `size` bytes declared) as far as OpenEXR would, keeping what the part checks need,
+// and refuses contents that claim more than `size`: OpenEXR allocates those claims
+// first. Leaves the reader where OpenEXR's would stand: past `size` bytes, except for
+// fixed-size types and channel lists, which OpenEXR reads by their layout, ignoring
+// the declared size.
 void read_exr_value(ExrHeaderReader& r, const std::string& name, const std::string& type, std::uint64_t size,
                     const std::string& label, ExrPartHeader& part) {
-  const std::uint64_t end = r.pos() + size;
-  if (name == "dataWindow" && type == "box2i" && size == 16) {
-    const std::int64_t x0 = r.i32(label), y0 = r.i32(label), x1 = r.i32(label), y1 = r.i32(label);
-    part.has_window = true;
-    part.width = x1 - x0 + 1;
-    part.height = y1 - y0 + 1;
-  } else if (name == "tiles" && type == "tiledesc" && size >= 8) {
-    part.tiled = true;
-    part.tile_width = r.u32(label);
-    part.tile_height = r.u32(label);
-  } else if (name == "compression" && type == "compression" && size == 1) {
-    part.compression = r.byte(label);
-  } else if (name == "channels" && type == "chlist") {
-    // name\0 then pixel type, pLinear, reserved, x and y sampling (16 bytes), until an empty name.
-    while (r.pos() < end) {
-      if (r.name("a channel name in " + label).empty()) break;
-      if (r.pos() + 16 > end) break;  // malformed: OpenEXR reports it
-      r.seek(r.pos() + 16);
-      ++part.channels;
+  const std::uint64_t start = r.pos();
+  std::uint64_t end = start + size;
+  if (const std::uint64_t fixed = exr_fixed_size(type)) {
+    end = start + fixed;
+    if (fixed > r.left()) r.fail(label + " is cut off by the end of the file (truncated?)");
+    if (name == "dataWindow" && type == "box2i") {
+      const std::int64_t x0 = r.i32(label), y0 = r.i32(label), x1 = r.i32(label), y1 = r.i32(label);
+      part.has_window = true;
+      part.width = x1 - x0 + 1;
+      part.height = y1 - y0 + 1;
+    } else if (name == "tiles" && type == "tiledesc") {
+      part.tiled = true;
+      part.tile_width = r.u32(label);
+      part.tile_height = r.u32(label);
+    } else if (name == "compression" && type == "compression") {
+      part.compression = r.byte(label);
     }
+  } else if (type == "chlist") {
+    // name\0 then pixel type, pLinear, reserved, x and y sampling (16 bytes), until an empty name.
+    for (;;) {
+      if (r.name("a channel name in " + label).empty()) break;
+      if (r.left() < 16) r.fail(label + " is cut off by the end of the file (truncated?)");
+      r.seek(r.pos() + 16);
+      if (name == "channels") ++part.channels;
+    }
+    end = r.pos();
   } else if (type == "preview" && size >= 8) {
     const double w = r.u32(label), h = r.u32(label);
     if (8.0 + w * h * 4.0 > double(size))
       r.fail(label + " claims a " + std::to_string(std::uint64_t(w)) + "x" + std::to_string(std::uint64_t(h)) +
              " preview (" + byte_text(w * h * 4.0) + ") in " + std::to_string(size) + " bytes");
+    end = start + 8 + std::uint64_t(w * h * 4.0);
+  } else if (type == "floatvector") {
+    end = start + size / 4 * 4;
   } else if (type == "stringvector") {
-    while (r.pos() + 4 <= end) {
+    while (r.pos() < end) {
       const std::int64_t n = r.i32(label);
-      if (n < 0 || std::uint64_t(n) > end - r.pos())
+      if (n < 0 || std::uint64_t(n) > end - std::min(end, r.pos()))
         r.fail(label + " holds a string that claims " + std::to_string(n) + " bytes but only " +
-               std::to_string(end - r.pos()) + " of the attribute's " + std::to_string(size) + " bytes follow it");
+               std::to_string(end - std::min(end, r.pos())) + " of the attribute's " + std::to_string(size) +
+               " bytes follow it");
       r.seek(r.pos() + std::uint64_t(n));
     }
   }
@@ -312,7 +354,7 @@ void check_exr_header_sizes(const std::string& path) {
         if (multipart && k == 0 && index > 0) return;  // the end of the list of headers
         break;
       }
-      const std::string label = "header attribute '" + name + "'" + where;
+      const std::string label = "header attribute '" + printable(name) + "'" + where;
       const std::string type = r.name("the type of " + label);
       const std::int64_t claim = r.i32("the size of " + label);
       if (claim < 0 || std::uint64_t(claim) > r.left())

@@ -324,6 +324,27 @@ TEST(InputLimits, MalformedHeaderNamesAreRefused) {
   expect_refused(f, {"the size of header attribute 'owner' is cut off by the end of the file"});
 }
 
+// OpenEXR reads fixed-size values and channel lists by their layout, ignoring the size
+// the header declares, and the next attribute starts where it stopped: the check walks
+// the header the same way (a fuzzed file hid an 842 MB claim behind a channel list).
+TEST(InputLimits, TheHeaderIsWalkedAsOpenExrWalksIt) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("walk.exr");
+  const std::string zero(1, '\0');
+  const std::string channel = "R" + zero + le32(2) + std::string(4, '\0') + le32(1) + le32(1);  // float, 1x1 sampling
+  const std::string claim = exr_attribute("\x13", "", 842019328, "") + std::string(64, 'x');
+  // A channel list declared 4 bytes long, 19 in fact.
+  write_exr_bytes(f, exr_attribute("channels", "chlist", 4, channel + zero) + claim);
+  expect_refused(f, {"'" + f + "'", "header attribute '\\x13' claims 842019328 bytes but only 64 of the file's"});
+  // A data window declared 0 bytes long, 16 in fact.
+  write_exr_bytes(f, exr_attribute("dataWindow", "box2i", 0, le32(0) + le32(0) + le32(7) + le32(7)) + claim);
+  expect_refused(f, {"header attribute '\\x13' claims 842019328 bytes but only 64 of the file's"});
+  // A data window declared 200 bytes long: OpenEXR still reads 16, then the claim.
+  write_exr_bytes(f, exr_attribute("dataWindow", "box2i", 200, le32(0) + le32(0) + le32(7) + le32(7)) + claim +
+                         std::string(200, 'y'));
+  expect_refused(f, {"header attribute '\\x13' claims 842019328 bytes but only 264 of the file's"});
+}
+
 TEST(InputLimits, ClaimsInsideAnAttributeAreRefused) {
   ScratchDir dir("mcrecon_limits");
   const std::string f = dir.path("inside.exr");
