@@ -299,11 +299,12 @@ std::int64_t exr_lines_per_chunk(int c) {
   }
 }
 
-// What opening a part allocates from its header. Its table of chunk offsets (8 bytes
+// What opening a part allocates from its header. A chunk of scanlines or a tile:
+// refuse one past the input budget. Its table of chunk offsets (8 bytes
 // a chunk) is part of the file, so a file smaller than that table claims a data
-// window it cannot hold. Its first tile is allocated too: refuse one past the input
-// budget, or past the data window by more than a writer that uses one tile size for
-// every image would (OpenEXR's and OpenImageIO's default is 64).
+// window it cannot hold. A tile past the data window by more than a writer that uses
+// one tile size for every image would use is refused too (OpenEXR's and OpenImageIO's
+// default is 64).
 void check_exr_part(const std::string& path, const ExrPartHeader& part, const std::string& where,
                     std::uint64_t file_size) {
   constexpr std::int64_t kUsualTile = 1024;
@@ -321,6 +322,14 @@ void check_exr_part(const std::string& path, const ExrPartHeader& part, const st
                                         ", the most a tile may exceed it by)");
   }
   if (!window || (part.tiled && (tw <= 0 || th <= 0))) return;
+  if (!part.tiled) {  // a chunk of scanlines is allocated when the file opens, as a tile is
+    const std::int64_t lines = std::min(exr_lines_per_chunk(part.compression), part.height);
+    const int c = std::max(part.channels, 1);
+    InputBudget::for_file(path, "openexr", exr_compression_name(part.compression))
+        .check(path, double(part.width) * double(lines) * c * 4.0,
+               "its header asks for scanlines of " + std::to_string(part.width) + "x" + std::to_string(c) +
+                   " float" + where + ", read " + std::to_string(lines) + " at a time");
+  }
   const double chunks = part.tiled ? std::ceil(double(part.width) / double(tw)) * std::ceil(double(part.height) / double(th))
                                    : std::ceil(double(part.height) / double(exr_lines_per_chunk(part.compression)));
   if (chunks * 8.0 > double(file_size))

@@ -410,6 +410,16 @@ TEST(InputLimits, HugeDeepTilesAreRefusedBeforeOpening) {
   expect_refused(f, {"'" + f + "'", "its header asks for tiles of 67108866x2x5 float (2.68 GB)", "can hold at most"});
 }
 
+TEST(InputLimits, WideScanlinesAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("wide.exr");
+  write_flat(f, 8, 8, 4, "zip");  // 16 scanlines a chunk
+  // 100 million pixels wide: OpenEXR would allocate line buffers of 8 x 1.6 GB when it opens the file.
+  ASSERT_EQ(patch_attribute(f, "dataWindow", "box2i", {0, 0, 99999999, 7}), 1);
+  expect_refused(f, {"'" + f + "'", "its header asks for scanlines of 100000000x4 float, read 8 at a time (12.8 GB)",
+                     "can hold at most"});
+}
+
 TEST(InputLimits, DataWindowsWhoseOffsetTableExceedsTheFileAreRefusedBeforeOpening) {
   ScratchDir dir("mcrecon_limits");
   const std::string f = dir.path("tall.exr");
