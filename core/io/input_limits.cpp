@@ -207,7 +207,9 @@ class ExrHeaderReader {
 
 // What the tile checks need from one part's header.
 struct ExrPartHeader {
-  bool has_window = false, tiled = false;
+  bool has_window = false, has_tiles = false;
+  bool tiled = false;  // read as tiles: set from the version flags and the "type" attribute
+  std::string type;    // the "type" attribute (multi-part and deep files)
   std::int64_t width = 0, height = 0;
   std::int64_t tile_width = 0, tile_height = 0;
   int channels = 0;
@@ -253,7 +255,7 @@ void read_exr_value(ExrHeaderReader& r, const std::string& name, const std::stri
       part.width = x1 - x0 + 1;
       part.height = y1 - y0 + 1;
     } else if (name == "tiles" && type == "tiledesc") {
-      part.tiled = true;
+      part.has_tiles = true;
       part.tile_width = r.u32(label);
       part.tile_height = r.u32(label);
     } else if (name == "compression" && type == "compression") {
@@ -268,7 +270,10 @@ void read_exr_value(ExrHeaderReader& r, const std::string& name, const std::stri
       if (name == "channels") ++part.channels;
     }
     end = r.pos();
-  } else if (type == "preview" && size >= 8) {
+  } else if (name == "type" && type == "string" && size <= 64) {
+    for (std::uint64_t i = 0; i < size; ++i) part.type += char(r.byte(label));
+  } else if (type == "preview") {
+    if (size < 8) r.fail(label + " holds " + std::to_string(size) + " bytes, too few for a preview's size");
     const double w = r.u32(label), h = r.u32(label);
     if (8.0 + w * h * 4.0 > double(size))
       r.fail(label + " claims a " + std::to_string(std::uint64_t(w)) + "x" + std::to_string(std::uint64_t(h)) +
@@ -310,7 +315,7 @@ void check_exr_part(const std::string& path, const ExrPartHeader& part, const st
   constexpr std::int64_t kUsualTile = 1024;
   const std::int64_t tw = part.tile_width, th = part.tile_height;
   const bool window = part.has_window && part.width > 0 && part.height > 0;  // else OpenEXR refuses it
-  if (part.tiled) {
+  if (part.tiled && part.has_tiles) {
     const InputBudget budget = InputBudget::for_file(path, "openexr", exr_compression_name(part.compression));
     budget.check(path, double(tw) * double(th) * std::max(part.channels, 1) * 4.0,
                  "its header asks for tiles of " + dims(tw, th, std::max(part.channels, 1)) + where);
@@ -321,7 +326,7 @@ void check_exr_part(const std::string& path, const ExrPartHeader& part, const st
                                         " data window (and than " + std::to_string(kUsualTile) +
                                         ", the most a tile may exceed it by)");
   }
-  if (!window || (part.tiled && (tw <= 0 || th <= 0))) return;
+  if (!window || (part.tiled && (!part.has_tiles || tw <= 0 || th <= 0))) return;  // OpenEXR refuses those
   if (!part.tiled) {  // a chunk of scanlines is allocated when the file opens, as a tile is
     const std::int64_t lines = std::min(exr_lines_per_chunk(part.compression), part.height);
     const int c = std::max(part.channels, 1);
@@ -350,7 +355,8 @@ void check_exr_header_sizes(const std::string& path) {
   unsigned char head[8];
   if (!file.read(reinterpret_cast<char*>(head), 8)) return;  // too short for an EXR: its reader says so
   if (std::memcmp(head, "\x76\x2f\x31\x01", 4) != 0) return;
-  const bool multipart = head[5] & 0x10;  // version flags (bits 8-31): 0x1000 multi-part
+  // Version flags (bits 8-31): 0x200 a single-part tiled file, 0x800 deep, 0x1000 multi-part.
+  const bool single_tiled = head[5] & 0x02, deep = head[5] & 0x08, multipart = head[5] & 0x10;
   ExrHeaderReader r(path, file, size, 8);
   // A single-part file has one header; a multi-part file a list of them, each ended
   // by an empty name, the list by one more.
@@ -371,6 +377,8 @@ void check_exr_header_sizes(const std::string& path) {
                " of the file's " + std::to_string(size) + " bytes follow it (truncated or corrupt?)");
       read_exr_value(r, name, type, std::uint64_t(claim), label, part);
     }
+    // Tiled as OpenEXR decides: multi-part and deep files by their type, others by the flag.
+    part.tiled = multipart || deep ? part.type == "tiledimage" || part.type == "deeptile" : single_tiled;
     check_exr_part(path, part, where, size);
     if (!multipart) return;
   }
