@@ -263,10 +263,16 @@ void read_exr_value(ExrHeaderReader& r, const std::string& name, const std::stri
     }
   } else if (type == "chlist") {
     // name\0 then pixel type, pLinear, reserved, x and y sampling (16 bytes), until an empty name.
+    // OpenImageIO 2.4 aborts on a pixel type it does not know: refuse any but uint, half, float.
     for (;;) {
-      if (r.name("a channel name in " + label).empty()) break;
+      const std::string channel = r.name("a channel name in " + label);
+      if (channel.empty()) break;
       if (r.left() < 16) r.fail(label + " is cut off by the end of the file (truncated?)");
-      r.seek(r.pos() + 16);
+      const std::int64_t pixel_type = r.i32(label);
+      if (name == "channels" && (pixel_type < 0 || pixel_type > 2))
+        r.fail("channel '" + printable(channel) + "' has pixel type " + std::to_string(pixel_type) +
+               " (OpenEXR's are 0 uint, 1 half, 2 float)");
+      r.seek(r.pos() + 12);
       if (name == "channels") ++part.channels;
     }
     end = r.pos();

@@ -345,6 +345,19 @@ TEST(InputLimits, TheHeaderIsWalkedAsOpenExrWalksIt) {
   expect_refused(f, {"header attribute '\\x13' claims 842019328 bytes but only 264 of the file's"});
 }
 
+// OpenImageIO 2.4 aborts the process on a channel of a pixel type it does not know.
+TEST(InputLimits, UnknownChannelPixelTypesAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("ptype.exr");
+  write_flat(f, 4, 4, 4, "zip");
+  std::string bytes = file_bytes(f);
+  const auto at = bytes.find(std::string("G\0", 2) + le32(2));  // channel G, float
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at + 2, 4, le32(3));
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
+  expect_refused(f, {"'" + f + "'", "channel 'G' has pixel type 3 (OpenEXR's are 0 uint, 1 half, 2 float)"});
+}
+
 TEST(InputLimits, ClaimsInsideAnAttributeAreRefused) {
   ScratchDir dir("mcrecon_limits");
   const std::string f = dir.path("inside.exr");
