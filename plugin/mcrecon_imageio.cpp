@@ -281,6 +281,7 @@ class McreconInput final : public ImageInput {
   // we return before it asks for a pixel.
   static ImageSpec source_header(const std::string& source) {
     mcr::require_regular_file(source);  // before any open(): a FIFO would block it
+    mcr::check_exr_header_sizes(source);  // before OpenEXR allocates what the header claims
     auto in = ImageInput::open(source);
     if (!in) {
       const std::string msg = OIIO::geterror();

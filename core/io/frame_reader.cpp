@@ -51,10 +51,17 @@ std::string part_label(const ImageSpec& spec, int part) {
   return "part " + std::to_string(part) + (name.empty() ? "" : " '" + name + "'");
 }
 
-void read_deep(RawImage& raw, const std::string& path) {
-  ImageBuf deepbuf(path);
-  if (!deepbuf.read(0, 0, true, TypeFloat) || !deepbuf.deep())
-    throw Error(Errc::ReadFailed, "cannot read deep pixels of '" + path + "': " + deepbuf.geterror());
+// Deep data comes through the ImageInput that read the header, never an ImageBuf
+// on the path: that would go through OpenImageIO's process-wide ImageCache, which
+// keeps serving the first file read at a path after the file is rewritten (a
+// re-rendered frame read again by the Python module, add-on or plugin).
+void read_deep(ImageInput& in, RawImage& raw, const std::string& path) {
+  if (!in.seek_subimage(0, 0)) throw Error(Errc::ReadFailed, "cannot read deep pixels of '" + path + "': " + in.geterror());
+  ImageBuf deepbuf(in.spec());  // deep spec: empty DeepData, no pixels
+  if (!deepbuf.deep() || !in.read_native_deep_image(0, 0, *deepbuf.deepdata()))
+    throw Error(Errc::ReadFailed, "cannot read deep pixels of '" + path + "' (truncated or corrupt?): " + in.geterror());
+  if (deepbuf.spec().width != raw.width || deepbuf.spec().height != raw.height)
+    throw Error(Errc::ReadFailed, "'" + path + "' changed while it was read");
   raw.deep = copy_deep(*deepbuf.deepdata(), deepbuf.spec());
   // Flat passes of a deep file: front-to-back composite of every channel.
   ImageBuf flat = ImageBufAlgo::flatten(deepbuf);
@@ -112,6 +119,7 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
 
 RawImage read_raw(const std::string& path) {
   require_regular_file(path);  // before any open(): a FIFO would block it
+  check_exr_header_sizes(path);  // before OpenEXR allocates what the header claims
   auto in = ImageInput::open(path);
   if (!in) {
     std::string msg = OIIO::geterror();
@@ -126,9 +134,8 @@ RawImage read_raw(const std::string& path) {
   raw.window = window_of(spec);
   try {
     if (spec.deep) {
-      in.reset();
       check_deep_samples(path, spec.nchannels, budget);
-      read_deep(raw, path);
+      read_deep(*in, raw, path);
     } else {
       read_parts(*in, raw, path);
     }

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <fstream>
 #include <vector>
 
 #include "util/error.h"
@@ -140,7 +141,254 @@ std::string dims(std::int64_t w, std::int64_t h, std::int64_t c) {
   return std::to_string(w) + "x" + std::to_string(h) + "x" + std::to_string(c) + " float";
 }
 
+// A name from a file as a message shows it: bytes outside printable ASCII as \xNN.
+std::string printable(const std::string& s) {
+  std::string out;
+  for (unsigned char c : s) {
+    if (c >= 0x20 && c < 0x7f) {
+      out += char(c);
+    } else {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\x%02x", c);
+      out += buf;
+    }
+  }
+  return out;
+}
+
+// An OpenEXR header read in order from its file, never past the file's end.
+class ExrHeaderReader {
+ public:
+  ExrHeaderReader(const std::string& path, std::ifstream& file, std::uint64_t size, std::uint64_t pos)
+      : path_(path), file_(file), size_(size), pos_(pos) {}
+  std::uint64_t pos() const { return pos_; }
+  std::uint64_t left() const { return size_ - pos_; }
+
+  // A NUL-terminated name ("" ends a header): at most 255 bytes, as OpenEXR's long names.
+  std::string name(const std::string& what) {
+    std::string s;
+    for (;;) {
+      const int c = file_.get();
+      if (c == std::char_traits<char>::eof())
+        fail(what + (s.empty() ? "" : " '" + printable(s) + "'") + " has no terminator: the file ends inside it (truncated?)");
+      ++pos_;
+      if (c == 0) return s;
+      if (s.size() == 255) fail(what + " '" + printable(s.substr(0, 32)) + "...' is longer than 255 bytes");
+      s += char(c);
+    }
+  }
+  std::int64_t i32(const std::string& what) { return std::int32_t(u32(what)); }
+  std::uint32_t u32(const std::string& what) {
+    unsigned char b[4];
+    if (left() < 4 || !file_.read(reinterpret_cast<char*>(b), 4))
+      fail(what + " is cut off by the end of the file (truncated?)");
+    pos_ += 4;
+    return std::uint32_t(b[0]) | std::uint32_t(b[1]) << 8 | std::uint32_t(b[2]) << 16 | std::uint32_t(b[3]) << 24;
+  }
+  int byte(const std::string& what) {
+    const int c = left() ? file_.get() : std::char_traits<char>::eof();
+    if (c == std::char_traits<char>::eof()) fail(what + " is cut off by the end of the file (truncated?)");
+    ++pos_;
+    return c;
+  }
+  void seek(std::uint64_t to) {  // to <= the file's size (callers check)
+    file_.seekg(std::streamoff(to));
+    pos_ = to;
+  }
+  [[noreturn]] void fail(const std::string& why) const {
+    throw Error(Errc::ReadFailed, "cannot read '" + path_ + "': " + why);
+  }
+
+ private:
+  const std::string& path_;
+  std::ifstream& file_;
+  std::uint64_t size_, pos_;
+};
+
+// What the tile checks need from one part's header.
+struct ExrPartHeader {
+  bool has_window = false, has_tiles = false;
+  bool tiled = false;  // read as tiles: set from the version flags and the "type" attribute
+  std::string type;    // the "type" attribute (multi-part and deep files)
+  std::int64_t width = 0, height = 0;
+  std::int64_t tile_width = 0, tile_height = 0;
+  int channels = 0;
+  int compression = -1;
+};
+
+// OpenEXR's compression enum, as max_expansion names them.
+std::string exr_compression_name(int c) {
+  static const char* names[] = {"none", "rle", "zips", "zip", "piz", "pxr24", "b44", "b44a", "dwaa", "dwab"};
+  return c >= 0 && c < 10 ? names[c] : "unknown";
+}
+
+// The bytes OpenEXR reads for a value of a fixed-size type, whatever size the header
+// declares (0: not such a type).
+std::uint64_t exr_fixed_size(const std::string& type) {
+  static const std::pair<const char*, int> sizes[] = {
+      {"box2i", 16},  {"box2f", 16},   {"compression", 1}, {"chromaticities", 32}, {"deepImageState", 1},
+      {"double", 8},  {"envmap", 1},   {"float", 4},       {"int", 4},             {"keycode", 28},
+      {"lineOrder", 1}, {"m33d", 72},  {"m33f", 36},       {"m44d", 128},          {"m44f", 64},
+      {"rational", 8}, {"tiledesc", 9}, {"timecode", 8},   {"v2d", 16},            {"v2f", 8},
+      {"v2i", 8},     {"v3d", 24},     {"v3f", 12},        {"v3i", 12}};
+  for (const auto& [t, n] : sizes)
+    if (type == t) return std::uint64_t(n);
+  return 0;
+}
+
+// Reads one attribute's value (the reader stands at its start; the file holds the
+// `size` bytes declared) as far as OpenEXR would, keeping what the part checks need,
+// and refuses contents that claim more than `size`: OpenEXR allocates those claims
+// first. Leaves the reader where OpenEXR's would stand: past `size` bytes, except for
+// fixed-size types and channel lists, which OpenEXR reads by their layout, ignoring
+// the declared size.
+void read_exr_value(ExrHeaderReader& r, const std::string& name, const std::string& type, std::uint64_t size,
+                    const std::string& label, ExrPartHeader& part) {
+  const std::uint64_t start = r.pos();
+  std::uint64_t end = start + size;
+  if (const std::uint64_t fixed = exr_fixed_size(type)) {
+    end = start + fixed;
+    if (fixed > r.left()) r.fail(label + " is cut off by the end of the file (truncated?)");
+    if (name == "dataWindow" && type == "box2i") {
+      const std::int64_t x0 = r.i32(label), y0 = r.i32(label), x1 = r.i32(label), y1 = r.i32(label);
+      part.has_window = true;
+      part.width = x1 - x0 + 1;
+      part.height = y1 - y0 + 1;
+    } else if (name == "tiles" && type == "tiledesc") {
+      part.has_tiles = true;
+      part.tile_width = r.u32(label);
+      part.tile_height = r.u32(label);
+    } else if (name == "compression" && type == "compression") {
+      part.compression = r.byte(label);
+    }
+  } else if (type == "chlist") {
+    // name\0 then pixel type, pLinear, reserved, x and y sampling (16 bytes), until an empty name.
+    // OpenImageIO 2.4 aborts on a pixel type it does not know: refuse any but uint, half, float.
+    for (;;) {
+      const std::string channel = r.name("a channel name in " + label);
+      if (channel.empty()) break;
+      if (r.left() < 16) r.fail(label + " is cut off by the end of the file (truncated?)");
+      const std::int64_t pixel_type = r.i32(label);
+      if (name == "channels" && (pixel_type < 0 || pixel_type > 2))
+        r.fail("channel '" + printable(channel) + "' has pixel type " + std::to_string(pixel_type) +
+               " (OpenEXR's are 0 uint, 1 half, 2 float)");
+      r.seek(r.pos() + 12);
+      if (name == "channels") ++part.channels;
+    }
+    end = r.pos();
+  } else if (name == "type" && type == "string" && size <= 64) {
+    for (std::uint64_t i = 0; i < size; ++i) part.type += char(r.byte(label));
+  } else if (type == "preview") {
+    if (size < 8) r.fail(label + " holds " + std::to_string(size) + " bytes, too few for a preview's size");
+    const double w = r.u32(label), h = r.u32(label);
+    if (8.0 + w * h * 4.0 > double(size))
+      r.fail(label + " claims a " + std::to_string(std::uint64_t(w)) + "x" + std::to_string(std::uint64_t(h)) +
+             " preview (" + byte_text(w * h * 4.0) + ") in " + std::to_string(size) + " bytes");
+    end = start + 8 + std::uint64_t(w * h * 4.0);
+  } else if (type == "floatvector") {
+    end = start + size / 4 * 4;
+  } else if (type == "stringvector") {
+    while (r.pos() < end) {
+      const std::int64_t n = r.i32(label);
+      if (n < 0 || std::uint64_t(n) > end - std::min(end, r.pos()))
+        r.fail(label + " holds a string that claims " + std::to_string(n) + " bytes but only " +
+               std::to_string(end - std::min(end, r.pos())) + " of the attribute's " + std::to_string(size) +
+               " bytes follow it");
+      r.seek(r.pos() + std::uint64_t(n));
+    }
+  }
+  r.seek(end);
+}
+
+// Scanlines per chunk of each OpenEXR compression (unknown ones: the most, 256).
+std::int64_t exr_lines_per_chunk(int c) {
+  switch (c) {
+    case 0: case 1: case 2: return 1;  // none, rle, zips
+    case 3: case 5: return 16;         // zip, pxr24
+    case 4: case 6: case 7: case 8: return 32;  // piz, b44, b44a, dwaa
+    default: return 256;               // dwab
+  }
+}
+
+// What opening a part allocates from its header. A chunk of scanlines or a tile:
+// refuse one past the input budget. Its table of chunk offsets (8 bytes
+// a chunk) is part of the file, so a file smaller than that table claims a data
+// window it cannot hold. A tile past the data window by more than a writer that uses
+// one tile size for every image would use is refused too (OpenEXR's and OpenImageIO's
+// default is 64).
+void check_exr_part(const std::string& path, const ExrPartHeader& part, const std::string& where,
+                    std::uint64_t file_size) {
+  constexpr std::int64_t kUsualTile = 1024;
+  const std::int64_t tw = part.tile_width, th = part.tile_height;
+  const bool window = part.has_window && part.width > 0 && part.height > 0;  // else OpenEXR refuses it
+  if (part.tiled && part.has_tiles) {
+    const InputBudget budget = InputBudget::for_file(path, "openexr", exr_compression_name(part.compression));
+    budget.check(path, double(tw) * double(th) * std::max(part.channels, 1) * 4.0,
+                 "its header asks for tiles of " + dims(tw, th, std::max(part.channels, 1)) + where);
+    if (window && ((tw > part.width && tw > kUsualTile) || (th > part.height && th > kUsualTile)))
+      throw Error(Errc::ReadFailed, "cannot read '" + path + "': its header asks for tiles of " + std::to_string(tw) +
+                                        "x" + std::to_string(th) + " pixels" + where + ", larger than its " +
+                                        std::to_string(part.width) + "x" + std::to_string(part.height) +
+                                        " data window (and than " + std::to_string(kUsualTile) +
+                                        ", the most a tile may exceed it by)");
+  }
+  if (!window || (part.tiled && (!part.has_tiles || tw <= 0 || th <= 0))) return;  // OpenEXR refuses those
+  if (!part.tiled) {  // a chunk of scanlines is allocated when the file opens, as a tile is
+    const std::int64_t lines = std::min(exr_lines_per_chunk(part.compression), part.height);
+    const int c = std::max(part.channels, 1);
+    InputBudget::for_file(path, "openexr", exr_compression_name(part.compression))
+        .check(path, double(part.width) * double(lines) * c * 4.0,
+               "its header asks for scanlines of " + std::to_string(part.width) + "x" + std::to_string(c) +
+                   " float" + where + ", read " + std::to_string(lines) + " at a time");
+  }
+  const double chunks = part.tiled ? std::ceil(double(part.width) / double(tw)) * std::ceil(double(part.height) / double(th))
+                                   : std::ceil(double(part.height) / double(exr_lines_per_chunk(part.compression)));
+  if (chunks * 8.0 > double(file_size))
+    throw Error(Errc::ReadFailed, "cannot read '" + path + "': its header asks for a " + std::to_string(part.width) +
+                                      "x" + std::to_string(part.height) + " data window" + where + " in " +
+                                      std::to_string(std::uint64_t(chunks)) + (part.tiled ? " tiles" : " chunks") +
+                                      ", whose table of offsets alone (" + byte_text(chunks * 8.0) +
+                                      ") exceeds the " + byte_text(double(file_size)) + " file (truncated or corrupt?)");
+}
+
 }  // namespace
+
+void check_exr_header_sizes(const std::string& path) {
+  struct stat st {};
+  if (::stat(path.c_str(), &st) != 0) return;  // require_regular_file reports that
+  const std::uint64_t size = std::uint64_t(st.st_size);
+  std::ifstream file(path, std::ios::binary);
+  unsigned char head[8];
+  if (!file.read(reinterpret_cast<char*>(head), 8)) return;  // too short for an EXR: its reader says so
+  if (std::memcmp(head, "\x76\x2f\x31\x01", 4) != 0) return;
+  // Version flags (bits 8-31): 0x200 a single-part tiled file, 0x800 deep, 0x1000 multi-part.
+  const bool single_tiled = head[5] & 0x02, deep = head[5] & 0x08, multipart = head[5] & 0x10;
+  ExrHeaderReader r(path, file, size, 8);
+  // A single-part file has one header; a multi-part file a list of them, each ended
+  // by an empty name, the list by one more.
+  for (int index = 0;; ++index) {
+    const std::string where = multipart ? " in part " + std::to_string(index) : "";
+    ExrPartHeader part;
+    for (int k = 0;; ++k) {
+      const std::string name = r.name("the name of header attribute " + std::to_string(k + 1) + where);
+      if (name.empty()) {
+        if (multipart && k == 0 && index > 0) return;  // the end of the list of headers
+        break;
+      }
+      const std::string label = "header attribute '" + printable(name) + "'" + where;
+      const std::string type = r.name("the type of " + label);
+      const std::int64_t claim = r.i32("the size of " + label);
+      if (claim < 0 || std::uint64_t(claim) > r.left())
+        r.fail(label + " claims " + std::to_string(claim) + " bytes but only " + std::to_string(r.left()) +
+               " of the file's " + std::to_string(size) + " bytes follow it (truncated or corrupt?)");
+      read_exr_value(r, name, type, std::uint64_t(claim), label, part);
+    }
+    // Tiled as OpenEXR decides: multi-part and deep files by their type, others by the flag.
+    part.tiled = multipart || deep ? part.type == "tiledimage" || part.type == "deeptile" : single_tiled;
+    check_exr_part(path, part, where, size);
+    if (!multipart) return;
+  }
+}
 
 InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec first = in.spec();  // a copy: seek_subimage changes in.spec()

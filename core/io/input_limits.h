@@ -53,6 +53,16 @@ class InputBudget {
   bool capped_ = false;     // the absolute cap, not the file, set bytes_
 };
 
+// For an OpenEXR file (by its magic number; any other file passes untouched), before
+// anything opens it: OpenEXR allocates an attribute's value at the size its header
+// declares before comparing that size with the file, and tile buffers at the tile
+// size the header claims. Reads the headers' attribute lists (at most the file) and
+// throws ReadFailed naming the file and attribute for a declared size past the end
+// of the file, a name without terminator or longer than 255 bytes, a preview or
+// string vector whose contents claim more than the attribute holds, and tiles larger
+// than the data window (past a usual tile size) or than the input budget.
+void check_exr_header_sizes(const std::string& path);
+
 // Checks an opened image's header against its file's budget before any pixel is
 // allocated: every part's pixels as float (all parts are held at once), a row of
 // tiles (what a tiled read buffers), and a deep part's per-pixel tables.

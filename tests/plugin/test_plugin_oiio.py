@@ -8,7 +8,8 @@ Covered: every non-temporal filter through the `?key=value` name, --iconfig and 
 plugin (-o:fileformatname=mcrecon) on the room sample; temporal filters over an
 `oiiotool --frames 1-16` run on the anim sample (skipped when none is registered); accumulate
 (`mcrecon denoise --accumulate`) over frames 1-4 of the anim sample in all three styles; the
-notes (an unused setting) as the mcreconNotes attribute; no hang on a corrupt EXR;
+notes (an unused setting) as the mcreconNotes attribute; no hang on a corrupt EXR; a header
+claiming more than its file holds refused before anything opens it;
 --list-formats; errors named as the CLI names them, with a non-zero exit; a read through
 OpenImageIO's Python module.
 """
@@ -135,6 +136,30 @@ class TestDiscovery(PluginTestBase):
             self.fail("reading a .mcrecon name of a corrupt EXR hung (> 10 s)")
         self.assertNotEqual(proc.returncode, 0)
         self.assertIn("mcrecon: error: ", proc.stdout + proc.stderr)
+
+
+    def test_header_claims_past_the_file_are_refused_before_opening(self):
+        # OpenEXR allocates an attribute at the size its header declares before comparing it
+        # with the file: the plugin refuses that header before anything opens it, as the CLI.
+        src = self.path("claim.exr")
+        tu.write_exr(src, np.full((4, 4, 4), 0.5, np.float32), RGBA)
+        with open(src, "rb") as f:
+            data = bytearray(f.read())
+        key = b"channels\0chlist\0"
+        at = data.index(key) + len(key)
+        data[at:at + 4] = (842019328).to_bytes(4, "little")
+        with open(src, "wb") as f:
+            f.write(bytes(data))
+        cli = tu.run_cli("denoise", src, "-o", self.path("cli.exr"), "-f", "box", check=False)
+        self.assertEqual(cli.returncode, 2, cli.stderr)
+        line = cli_error_line(cli)
+        self.assertIn("header attribute 'channels' claims 842019328 bytes", line)
+        proc = oiiotool("--info", "-v", src + ".mcrecon?filter=box", timeout=60)
+        self.assertIn("mcreconError", proc.stdout)
+        self.assertIn(line, proc.stdout)
+        proc = oiiotool(src + ".mcrecon?filter=box", "-o", self.path("o.exr"), timeout=60)
+        self.assertNotEqual(proc.returncode, 0)
+        self.assertIn(line, proc.stdout + proc.stderr)
 
 
 class TestMatchesCli(PluginTestBase):

@@ -599,6 +599,45 @@ TEST_F(FrameIoTest, DeepFileKeepsEverySampleAndFlattensTheColour) {
     }
 }
 
+// A file rewritten at the same path in one process (a re-rendered frame read again
+// by the Python module, add-on or plugin) is read afresh: deep samples and flat
+// passes both come from the new file, not from a cache of the first.
+TEST_F(FrameIoTest, DeepFileRewrittenAtTheSamePathIsReadAfresh) {
+  const auto write = [&](int w, int h, int n, float v) {
+    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeFloat);
+    spec.channelnames = {"R", "G", "B", "A"};
+    spec.alpha_channel = 3;
+    spec.deep = true;
+    spec.attribute("compression", "zips");
+    OIIO::DeepData dd(spec);
+    for (int p = 0; p < w * h; ++p) {
+      dd.set_samples(p, n);
+      for (int s = 0; s < n; ++s)
+        for (int c = 0; c < 4; ++c) dd.set_deep_value(p, c, s, c == 3 ? 0.5f : v);
+    }
+    auto out = OIIO::ImageOutput::create(path("deep.exr"));
+    ASSERT_TRUE(out && out->open(path("deep.exr"), spec) && out->write_deep_image(dd)) << OIIO::geterror();
+    out->close();
+  };
+  write(3, 2, 1, 0.25f);
+  const Frame first = read_frame(path("deep.exr"));
+  ASSERT_TRUE(first.deep);
+  EXPECT_EQ(first.deep->total_samples(), 6u);
+
+  write(5, 4, 2, 0.125f);
+  const Frame second = read_frame(path("deep.exr"));
+  ASSERT_TRUE(second.deep);
+  EXPECT_EQ(second.width, 5);
+  EXPECT_EQ(second.deep->width, 5);
+  EXPECT_EQ(second.deep->height, 4);
+  ASSERT_EQ(second.deep->total_samples(), 40u);
+  const int r = second.deep->channel("R");
+  ASSERT_GE(r, 0);
+  for (float v : second.deep->values[std::size_t(r)]) EXPECT_EQ(v, 0.125f);
+  // Two samples of colour 0.125 (premultiplied) and alpha 0.5: 0.125 + 0.5 * 0.125.
+  EXPECT_NEAR(second.image(Role::Colour).at(4, 3, 0), 0.1875f, 1e-6f);
+}
+
 // ---------------------------------------------------------------- sequences
 
 TEST(SequenceTest, PatternsAndPaths) {

@@ -250,6 +250,204 @@ TEST(InputLimits, DeepSampleCountsAreCheckedBeforeTheSamples) {
   expect_error(Errc::ReadFailed, {"'" + f + "'", "20000x20000x4 float", "can hold at most"}, [&] { read_frame(f); });
 }
 
+// ------------------------------------------------------------------ OpenEXR header pre-check
+// OpenEXR allocates what a header declares before comparing it with the file;
+// check_exr_header_sizes refuses such claims before OpenImageIO/OpenEXR open the file.
+
+std::string le32(std::int32_t v) {
+  std::string b(4, '\0');
+  for (int i = 0; i < 4; ++i) b[std::size_t(i)] = char((std::uint32_t(v) >> (8 * i)) & 0xff);
+  return b;
+}
+
+// name\0 type\0 int32 size, value.
+std::string exr_attribute(const std::string& name, const std::string& type, std::int32_t size, const std::string& value) {
+  return name + std::string(1, '\0') + type + std::string(1, '\0') + le32(size) + value;
+}
+
+// The magic number, version 2 with `flags`, then `body` (attributes and header ends).
+void write_exr_bytes(const std::string& path, const std::string& body, std::int32_t flags = 0) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << std::string("\x76\x2f\x31\x01", 4) << le32(2 | flags)
+                                                           << body;
+}
+
+// Reading `f` every way (frame, loose pass, the check alone) fails with all of `parts`.
+void expect_refused(const std::string& f, const std::vector<std::string>& parts) {
+  expect_error(Errc::ReadFailed, parts, [&] { read_frame(f); });
+  expect_error(Errc::ReadFailed, parts, [&] { read_pass_file(f, Role::Colour); });
+  expect_error(Errc::ReadFailed, parts, [&] { check_exr_header_sizes(f); });
+}
+
+TEST(InputLimits, AttributeSizePastTheEndOfTheFileIsRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("claim.exr");
+  // A real file with a string attribute, whose declared size then claims 842019328 bytes
+  // (OpenEXR would allocate them before reading).
+  {
+    OIIO::ImageSpec spec(8, 8, 4, OIIO::TypeFloat);
+    spec.attribute("note", "abc");
+    std::vector<float> px(8 * 8 * 4, 0.5f);
+    auto out = OIIO::ImageOutput::create(f);
+    ASSERT_TRUE(out && out->open(f, spec) && out->write_image(OIIO::TypeFloat, px.data())) << OIIO::geterror();
+    out->close();
+  }
+  EXPECT_NO_THROW(check_exr_header_sizes(f));  // the file as written passes
+  EXPECT_EQ(read_frame(f).width, 8);
+  std::string bytes = file_bytes(f);
+  const std::string key = std::string("note\0string\0", 12);
+  const auto at = bytes.find(key);
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at + key.size(), 4, le32(842019328));
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
+  const std::uint64_t left = bytes.size() - (at + key.size() + 4);
+  expect_refused(f, {"'" + f + "'", "header attribute 'note' claims 842019328 bytes but only " +
+                                        std::to_string(left) + " of the file's " + std::to_string(bytes.size()) +
+                                        " bytes follow it"});
+  // Negative sizes too.
+  bytes.replace(at + key.size(), 4, le32(-5));
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
+  expect_refused(f, {"'" + f + "'", "header attribute 'note' claims -5 bytes"});
+}
+
+TEST(InputLimits, MalformedHeaderNamesAreRefused) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("names.exr");
+  write_exr_bytes(f, "dataWin");  // the file ends inside a name
+  expect_refused(f, {"'" + f + "'", "the name of header attribute 1 'dataWin' has no terminator"});
+  write_exr_bytes(f, exr_attribute("owner", "string", 2, "me") + "lineOrder");
+  expect_refused(f, {"the name of header attribute 2 'lineOrder' has no terminator"});
+  write_exr_bytes(f, std::string("owner\0stri", 10));  // ... or inside a type
+  expect_refused(f, {"the type of header attribute 'owner' 'stri' has no terminator"});
+  write_exr_bytes(f, exr_attribute(std::string(300, 'n'), "string", 2, "me") + std::string(1, '\0'));
+  expect_refused(f, {"'" + f + "'", "the name of header attribute 1 '" + std::string(32, 'n') + "...' is longer than 255 bytes"});
+  write_exr_bytes(f, std::string("owner\0string\0\x02\0", 15));  // a size cut short
+  expect_refused(f, {"the size of header attribute 'owner' is cut off by the end of the file"});
+}
+
+// OpenEXR reads fixed-size values and channel lists by their layout, ignoring the size
+// the header declares, and the next attribute starts where it stopped: the check walks
+// the header the same way (a fuzzed file hid an 842 MB claim behind a channel list).
+TEST(InputLimits, TheHeaderIsWalkedAsOpenExrWalksIt) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("walk.exr");
+  const std::string zero(1, '\0');
+  const std::string channel = "R" + zero + le32(2) + std::string(4, '\0') + le32(1) + le32(1);  // float, 1x1 sampling
+  const std::string claim = exr_attribute("\x13", "", 842019328, "") + std::string(64, 'x');
+  // A channel list declared 4 bytes long, 19 in fact.
+  write_exr_bytes(f, exr_attribute("channels", "chlist", 4, channel + zero) + claim);
+  expect_refused(f, {"'" + f + "'", "header attribute '\\x13' claims 842019328 bytes but only 64 of the file's"});
+  // A data window declared 0 bytes long, 16 in fact.
+  write_exr_bytes(f, exr_attribute("dataWindow", "box2i", 0, le32(0) + le32(0) + le32(7) + le32(7)) + claim);
+  expect_refused(f, {"header attribute '\\x13' claims 842019328 bytes but only 64 of the file's"});
+  // A data window declared 200 bytes long: OpenEXR still reads 16, then the claim.
+  write_exr_bytes(f, exr_attribute("dataWindow", "box2i", 200, le32(0) + le32(0) + le32(7) + le32(7)) + claim +
+                         std::string(200, 'y'));
+  expect_refused(f, {"header attribute '\\x13' claims 842019328 bytes but only 264 of the file's"});
+}
+
+// OpenImageIO 2.4 aborts the process on a channel of a pixel type it does not know.
+TEST(InputLimits, UnknownChannelPixelTypesAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("ptype.exr");
+  write_flat(f, 4, 4, 4, "zip");
+  std::string bytes = file_bytes(f);
+  const auto at = bytes.find(std::string("G\0", 2) + le32(2));  // channel G, float
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at + 2, 4, le32(3));
+  std::ofstream(f, std::ios::binary | std::ios::trunc) << bytes;
+  expect_refused(f, {"'" + f + "'", "channel 'G' has pixel type 3 (OpenEXR's are 0 uint, 1 half, 2 float)"});
+}
+
+TEST(InputLimits, ClaimsInsideAnAttributeAreRefused) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("inside.exr");
+  // A string vector whose one string claims a million bytes in an 8-byte value.
+  write_exr_bytes(f, exr_attribute("views", "stringvector", 8, le32(1000000) + "abcd") + std::string(1, '\0'));
+  expect_refused(f, {"'" + f + "'", "header attribute 'views' holds a string that claims 1000000 bytes but only 4 of "
+                                    "the attribute's 8 bytes follow it"});
+  // A 60000x60000 preview (14.4 GB) in 16 bytes.
+  write_exr_bytes(f, exr_attribute("preview", "preview", 16, le32(60000) + le32(60000) + "rgbargba") + std::string(1, '\0'));
+  expect_refused(f, {"header attribute 'preview' claims a 60000x60000 preview (14.4 GB) in 16 bytes"});
+}
+
+TEST(InputLimits, EveryPartOfAMultiPartHeaderIsChecked) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("parts.exr");
+  write_two_parts(f, 8, 8);
+  EXPECT_NO_THROW(check_exr_header_sizes(f));
+  // The same attribute in part 1 only claims too much.
+  const std::string part0 = exr_attribute("name", "string", 3, "one") + std::string(1, '\0');
+  const std::string part1 = exr_attribute("name", "string", 3, "two") + exr_attribute("note", "string", 99999, "x") +
+                            std::string(1, '\0');
+  write_exr_bytes(f, part0 + part1 + std::string(1, '\0'), 0x1000);
+  expect_refused(f, {"'" + f + "'", "header attribute 'note' in part 1 claims 99999 bytes"});
+}
+
+TEST(InputLimits, TilesLargerThanTheDataWindowAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("tiled.exr");
+  write_flat(f, 16, 16, 4, "zip", OIIO::TypeFloat, 16);
+  EXPECT_NO_THROW(check_exr_header_sizes(f));
+  // 2048x16 tiles of 4 float channels (512 KB) fit the budget but not a 16x16 image.
+  ASSERT_EQ(patch_attribute(f, "tiles", "tiledesc", {2048, 16}), 1);
+  expect_refused(f, {"'" + f + "'", "its header asks for tiles of 2048x16 pixels, larger than its 16x16 data window"});
+  // A usual tile size on a small image reads.
+  write_flat(f, 5, 4, 4, "zip", OIIO::TypeFloat, 64);
+  EXPECT_EQ(read_frame(f).width, 5);
+}
+
+TEST(InputLimits, HugeDeepTilesAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("deep_tiled.exr");
+  // A 5x4 deep tiled file (5 channels) whose header then claims 67108866x2 tiles: OpenEXR
+  // would allocate tile buffers of that size when the file opens.
+  {
+    OIIO::ImageSpec spec(5, 4, 5, OIIO::TypeHalf);
+    spec.channelnames = {"R", "G", "B", "A", "Z"};
+    spec.alpha_channel = 3;
+    spec.z_channel = 4;
+    spec.deep = true;
+    spec.tile_width = spec.tile_height = 16;
+    spec.attribute("compression", "zips");
+    OIIO::DeepData dd(spec);
+    for (int p = 0; p < 20; ++p) {
+      dd.set_samples(p, 1);
+      for (int c = 0; c < 5; ++c) dd.set_deep_value(p, c, 0, 0.5f);
+    }
+    auto out = OIIO::ImageOutput::create(f);
+    ASSERT_TRUE(out && out->open(f, spec) && out->write_deep_image(dd)) << OIIO::geterror();
+    out->close();
+  }
+  EXPECT_EQ(read_frame(f).deep->total_samples(), 20u);
+  ASSERT_EQ(patch_attribute(f, "tiles", "tiledesc", {67108866, 2}), 1);
+  expect_refused(f, {"'" + f + "'", "its header asks for tiles of 67108866x2x5 float (2.68 GB)", "can hold at most"});
+}
+
+TEST(InputLimits, WideScanlinesAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("wide.exr");
+  write_flat(f, 8, 8, 4, "zip");  // 16 scanlines a chunk
+  // 100 million pixels wide: OpenEXR would allocate line buffers of 8 x 1.6 GB when it opens the file.
+  ASSERT_EQ(patch_attribute(f, "dataWindow", "box2i", {0, 0, 99999999, 7}), 1);
+  expect_refused(f, {"'" + f + "'", "its header asks for scanlines of 100000000x4 float, read 8 at a time (12.8 GB)",
+                     "can hold at most"});
+}
+
+TEST(InputLimits, DataWindowsWhoseOffsetTableExceedsTheFileAreRefusedBeforeOpening) {
+  ScratchDir dir("mcrecon_limits");
+  const std::string f = dir.path("tall.exr");
+  write_flat(f, 8, 8, 4, "zips");  // one scanline a chunk: 8 bytes of offset table a line
+  const auto size = fs::file_size(f);
+  // 100 million lines: OpenEXR would allocate an 800 MB offset table when it opens the file.
+  ASSERT_EQ(patch_attribute(f, "dataWindow", "box2i", {0, 0, 7, 99999999}), 1);
+  expect_refused(f, {"'" + f + "'", "a 8x100000000 data window in 100000000 chunks, whose table of offsets alone (800 MB) "
+                                    "exceeds the " + byte_text(double(size)) + " file"});
+  // Tiles: 16x16 tiles over 160000x160000 pixels are 10000^2 offsets (800 MB).
+  write_flat(f, 16, 16, 4, "zip", OIIO::TypeFloat, 16);
+  ASSERT_EQ(patch_attribute(f, "dataWindow", "box2i", {0, 0, 159999, 159999}), 1);
+  expect_refused(f, {"'" + f + "'", "in 100000000 tiles, whose table of offsets alone (800 MB)"});
+}
+
 // Each compression's bound against the best ratio it reaches here: a constant
 // image (float bytes per file byte), with margin to spare for larger images.
 TEST(InputLimits, BoundsExceedMeasuredRatios) {
