@@ -20,8 +20,8 @@ import threading
 import numpy as np
 import OpenImageIO as oiio
 
-sys.path.insert(0, os.environ["MCRECON_PYTHON_DIR"])
-import mcrecon  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from module_testutil import expect_error, mcrecon  # noqa: E402
 
 SRC = os.environ["MCRECON_SOURCE_DIR"]
 BIN = os.environ["MCRECON_BIN"]
@@ -46,19 +46,6 @@ def read_channels(path):
 
 def group(names, px, prefix, suffixes):
     return np.ascontiguousarray(np.stack([px[:, :, names.index(prefix + "." + s)] for s in suffixes], axis=-1))
-
-
-def expect_error(fn, kind, *words):
-    try:
-        fn()
-    except mcrecon.Error as e:
-        msg = str(e)
-        assert e.kind == kind, f"kind {e.kind!r}, expected {kind!r} ({msg})"
-        for w in words:
-            assert w in msg, f"error message {msg!r} does not name {w!r}"
-        assert isinstance(e, RuntimeError)
-        return msg
-    raise AssertionError(f"no mcrecon.Error ({kind}) raised")
 
 
 def test_filters_match_cli():

@@ -18,24 +18,12 @@ import threading
 
 import numpy as np
 
-sys.path.insert(0, os.environ["MCRECON_PYTHON_DIR"])
-import mcrecon  # noqa: E402
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from module_testutil import expect_error, mcrecon  # noqa: E402
 
 SRC = os.environ["MCRECON_SOURCE_DIR"]
 ANIM1 = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_0001.exr")
 INT_MAX = 2**31 - 1
-
-
-def expect_error(fn, kind, *words):
-    try:
-        fn()
-    except mcrecon.Error as e:
-        msg = str(e)
-        assert e.kind == kind, f"kind {e.kind!r}, expected {kind!r} ({msg})"
-        for w in words:
-            assert w in msg, f"error message {msg!r} does not name {w!r}"
-        return msg
-    raise AssertionError(f"no mcrecon.Error (expected {kind}: {words})")
 
 
 def static_frame(h=40, w=48):
