@@ -89,11 +89,7 @@ int run_denoise(const DenoiseArgs& a) {
     if (!std::filesystem::exists(j.first, ec)) throw Error(Errc::FileNotFound, "cannot read '" + j.first + "': no such file");
     inputs.push_back(j.first);
   }
-  // Loose pass files (--pass normal=n.exr) are inputs too.
-  for (const PassOverride& o : ro.overrides) {
-    std::error_code ec;
-    if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
-  }
+  for (std::string& f : loose_pass_files(ro)) inputs.push_back(std::move(f));  // --pass normal=n.exr
   std::vector<std::string> outputs;
   for (const auto& j : jobs) outputs.push_back(j.second);
   if (seq) check_sequence_outputs(a.output, parse_frame_range(a.frames), inputs);  // every frame its own file

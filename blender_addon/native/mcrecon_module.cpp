@@ -497,10 +497,7 @@ PYBIND11_MODULE(mcrecon, m) {
           if (!std::filesystem::exists(inputs.back(), ec))
             throw mcr::Error(Errc::FileNotFound, "cannot read '" + inputs.back() + "': no such file");
         }
-        for (const mcr::PassOverride& o : read_options(layer, passes).overrides) {  // loose pass files
-          std::error_code ec;
-          if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
-        }
+        for (std::string& f : mcr::loose_pass_files(read_options(layer, passes))) inputs.push_back(std::move(f));
         mcr::check_sequence_outputs(output, {first, last}, inputs);
         Session s(filter, params, threads, accumulate);
         py::list outputs;

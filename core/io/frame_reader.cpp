@@ -204,6 +204,15 @@ Pass resolve_override(const RawImage& raw, const std::vector<ChannelGroup>& grou
 
 }  // namespace
 
+std::vector<std::string> loose_pass_files(const ReadOptions& options) {
+  std::vector<std::string> files;
+  for (const PassOverride& o : options.overrides) {
+    std::error_code ec;
+    if (fs::is_regular_file(o.value, ec)) files.push_back(o.value);
+  }
+  return files;
+}
+
 PassOverride parse_pass_override(const std::string& text) {
   const auto eq = text.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == text.size())

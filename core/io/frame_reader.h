@@ -23,6 +23,10 @@ struct ReadOptions {
 // Parses "normal=normals.exr" into an override; throws InvalidArgument.
 PassOverride parse_pass_override(const std::string& text);
 
+// The overrides that name a file (not a channel group): inputs of the run, which no
+// output may overwrite.
+std::vector<std::string> loose_pass_files(const ReadOptions& options);
+
 // Reads every pass of the file (deep files: the per-sample buffer plus the
 // flattened passes). Throws FileNotFound, NotAnImage, ReadFailed, MissingPass,
 // SizeMismatch, each naming the file and pass.

@@ -1,7 +1,6 @@
 #include "pipeline/denoise_session.h"
 
 #include <chrono>
-#include <filesystem>
 
 #include "io/exr_output.h"
 #include "io/output_guard.h"
@@ -31,11 +30,8 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
   if (!output.empty()) {
     // Every front end's file run passes here: the output is checked against every
     // input of the run (the render and any loose pass file) before anything is read.
-    std::vector<std::string> inputs = {input};
-    for (const PassOverride& o : read.overrides) {
-      std::error_code ec;
-      if (std::filesystem::is_regular_file(o.value, ec)) inputs.push_back(o.value);
-    }
+    std::vector<std::string> inputs = loose_pass_files(read);
+    inputs.push_back(input);
     check_output_path(output, inputs);
     check_exr_name(output);  // Python and the add-on too: never EXR data under another name
     checked_exr_compression(write.compression);

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "blender_channels_testutil.h"
+#include "deep_file_testutil.h"
 #include "expect_error.h"
 #include "io/atomic_write.h"
 #include "io/frame_reader.h"
@@ -603,28 +604,12 @@ TEST_F(FrameIoTest, DeepFileKeepsEverySampleAndFlattensTheColour) {
 // by the Python module, add-on or plugin) is read afresh: deep samples and flat
 // passes both come from the new file, not from a cache of the first.
 TEST_F(FrameIoTest, DeepFileRewrittenAtTheSamePathIsReadAfresh) {
-  const auto write = [&](int w, int h, int n, float v) {
-    OIIO::ImageSpec spec(w, h, 4, OIIO::TypeFloat);
-    spec.channelnames = {"R", "G", "B", "A"};
-    spec.alpha_channel = 3;
-    spec.deep = true;
-    spec.attribute("compression", "zips");
-    OIIO::DeepData dd(spec);
-    for (int p = 0; p < w * h; ++p) {
-      dd.set_samples(p, n);
-      for (int s = 0; s < n; ++s)
-        for (int c = 0; c < 4; ++c) dd.set_deep_value(p, c, s, c == 3 ? 0.5f : v);
-    }
-    auto out = OIIO::ImageOutput::create(path("deep.exr"));
-    ASSERT_TRUE(out && out->open(path("deep.exr"), spec) && out->write_deep_image(dd)) << OIIO::geterror();
-    out->close();
-  };
-  write(3, 2, 1, 0.25f);
+  write_deep_file(path("deep.exr"), 3, 2, 1, 0.25f);
   const Frame first = read_frame(path("deep.exr"));
   ASSERT_TRUE(first.deep);
   EXPECT_EQ(first.deep->total_samples(), 6u);
 
-  write(5, 4, 2, 0.125f);
+  write_deep_file(path("deep.exr"), 5, 4, 2, 0.125f);
   const Frame second = read_frame(path("deep.exr"));
   ASSERT_TRUE(second.deep);
   EXPECT_EQ(second.width, 5);

@@ -22,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "deep_file_testutil.h"
 #include "expect_error.h"
 #include "io/frame_reader.h"
 #include "io/input_limits.h"
@@ -72,24 +73,6 @@ void write_two_parts(const std::string& path, int w, int h) {
   ASSERT_TRUE(out->write_image(OIIO::TypeFloat, px.data()));
   ASSERT_TRUE(out->open(path, specs[1], OIIO::ImageOutput::AppendSubimage));
   ASSERT_TRUE(out->write_image(OIIO::TypeFloat, px.data()));
-  out->close();
-}
-
-// A w x h deep RGBA file with n samples in every pixel.
-void write_deep(const std::string& path, int w, int h, int n) {
-  OIIO::ImageSpec spec(w, h, 4, OIIO::TypeFloat);
-  spec.channelnames = {"R", "G", "B", "A"};
-  spec.alpha_channel = 3;
-  spec.deep = true;
-  spec.attribute("compression", "zips");
-  OIIO::DeepData dd(spec);
-  for (int p = 0; p < w * h; ++p) {
-    dd.set_samples(p, n);
-    for (int s = 0; s < n; ++s)
-      for (int c = 0; c < 4; ++c) dd.set_deep_value(p, c, s, 0.01f);
-  }
-  auto out = OIIO::ImageOutput::create(path);
-  ASSERT_TRUE(out && out->open(path, spec) && out->write_deep_image(dd)) << OIIO::geterror();
   out->close();
 }
 
@@ -236,7 +219,7 @@ TEST(InputLimits, HugeTilesAreRefused) {
 TEST(InputLimits, DeepSampleCountsAreCheckedBeforeTheSamples) {
   ScratchDir dir("mcrecon_limits");
   const std::string f = dir.path("deep.exr");
-  write_deep(f, 32, 32, 100);  // 102400 samples x 4 channels = 1.64 MB as float
+  write_deep_file(f, 32, 32, 100, 0.01f);  // 102400 samples x 4 channels = 1.64 MB as float
   EXPECT_EQ(read_frame(f).deep->total_samples(), 102400u);
   {
     // The header (32x32 pixels, tables included) fits 1 MB; the samples do not.
