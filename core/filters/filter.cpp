@@ -1,13 +1,25 @@
 #include "filters/filter.h"
 
 #include <algorithm>
+#include <cstdio>
 
 #include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
+#include "prepare/step_back.h"
 #include "util/error.h"
 #include "util/isa.h"
 
 namespace mcr {
+
+namespace {
+
+std::string fixed_text(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
+  return buf;
+}
+
+}  // namespace
 
 ParamTable with_common_params(ParamTable own) { return with_preparation_params(std::move(own), PrepSteps{}); }
 
@@ -156,6 +168,12 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     throw Error(Errc::Internal, "filter '" + info_.name + "' returned an output of another size");
   repaired_ = finish(prepared_, input, roi, nthreads, out);
   if (repaired_) note(std::to_string(repaired_) + " non-finite output values replaced by 0");
+  if (info_.steps.step_back && params_.get_bool("step_back")) {
+    const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi,
+                                       int(params_.get_int("step_back_radius")), nthreads, out);
+    note("step_back: mean weight of the filtered result " + fixed_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
+         fixed_text(100.0 * sb.input_share, 1) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
+  }
   prepared_.own = Frame{};  // the copied passes are not kept between frames
   prepared_.colour = Image{};
   return out;

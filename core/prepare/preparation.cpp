@@ -41,6 +41,15 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                    "clamp every colour channel to [-clamp, clamp] before filtering (after demodulation and "
                                    "firefly suppression); 0 = off"));
   }
+  if (steps.step_back) {
+    own.push_back(ParamSpec::Bool("step_back", true,
+                                  "after filtering, blend the result toward the input wherever it is not estimated to beat "
+                                  "it (noise estimated from the image; Stein's unbiased risk estimate per window): a clean "
+                                  "render stays nearly as it was, a filter's bias (light spread from a highlight, a shadow "
+                                  "averaged away) is undone; fireflies still go"));
+    own.push_back(ParamSpec::Int("step_back_radius", 4, 1, 16,
+                                 "half width of the window over which step_back weighs the result against the input"));
+  }
   return own;
 }
 
@@ -105,6 +114,8 @@ std::vector<std::string> preparation_unused(const ParamSet& params, const PrepSt
   if (steps.albedo_prefilter && !(params.get_float("albedo_prefilter") > 0))
     report_unused(params, "albedo_prefilter_position", "with albedo_prefilter=0", notes);
   if (steps.demodulate && !params.get_bool("demodulate")) report_unused(params, "albedo_floor", "with demodulate=false", notes);
+  if (steps.step_back && !params.get_bool("step_back"))
+    report_unused(params, "step_back_radius", "with step_back=false", notes);
   return notes;
 }
 

@@ -9,6 +9,9 @@
 //                    demodulate, albedo_floor
 //   outliers         bright outliers clamped (prepare/outliers.h): firefly_k (0 = off),
 //                    firefly_radius; then every channel clamped to [-clamp, clamp] (0 = off)
+// and one step after run() and remodulation:
+//   step_back        the result blended toward the input wherever it is not estimated to
+//                    beat it (prepare/step_back.h): step_back, step_back_radius
 // A filter states which steps it takes (FilterInfo::steps); its parameter table gets the
 // parameters of those steps only, and no filter reads them: run() receives their result.
 // Each step works on the region the filter reads (the roi grown by its reach); outside
@@ -24,8 +27,8 @@
 namespace mcr {
 
 struct PrepSteps {
-  bool holes = true, albedo_prefilter = true, demodulate = true, outliers = true;
-  static PrepSteps none() { return {false, false, false, false}; }
+  bool holes = true, albedo_prefilter = true, demodulate = true, outliers = true, step_back = true;
+  static PrepSteps none() { return {false, false, false, false, false}; }
 };
 
 // `own` followed by the parameters of the steps.

@@ -49,6 +49,7 @@ const FilterInfo& BmfrFilter::static_info() {
     // Demodulation is bmfr's own (fused into phase I, remodulated before TAA): it takes
     // every preparation step but that one.
     i.steps.demodulate = false;
+    i.steps.step_back = false;  // the temporal output's own safeguards: issue 15
     i.params = with_preparation_params({
         ParamSpec::Int("block_size", 0, 0, 128,
                        "side of the square regression blocks in pixels (8..128); 0 = auto: 32 (the paper's) when the "

@@ -1,0 +1,173 @@
+#include "kernels/noise_scale.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "kernels/window_sums.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+constexpr int kVarianceRadius = 3;
+constexpr int kTile = 4, kTileGrow = 4;
+constexpr double kRelativeEps = 1e-3;  // luminance^2 below which noise counts as absolute
+constexpr double kChi2MedianToMean = 1.27;
+constexpr double kFloorRelative = 0.02;
+
+// The frame's RGB at (x, y) and whether it is finite.
+struct Rgb {
+  const Image& img;
+  bool finite(int x, int y) const {
+    const float* p = img.pixel(x, y);
+    return std::isfinite(p[0]) && std::isfinite(p[1]) && std::isfinite(p[2]);
+  }
+  const float* at(int x, int y) const { return img.pixel(x, y); }
+};
+
+float median_of(float* v, int n) {
+  std::nth_element(v, v + n / 2, v + n);
+  const float hi = v[n / 2];
+  if (n % 2) return hi;
+  return 0.5f * (*std::max_element(v, v + n / 2) + hi);
+}
+
+}  // namespace
+
+NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads) {
+  const int W = colour.width(), H = colour.height();
+  NoiseScales s;
+  s.box = box_in.clipped(W, H);
+  if (s.box.empty()) return s;
+  const Rgb y{colour};
+  const std::size_t n = std::size_t(s.box.width()) * std::size_t(s.box.height());
+  s.variance.assign(n, 0.0f);
+  s.robust.assign(n, 0.0f);
+  s.median.assign(n * 3, 0.0f);
+  s.finite.assign(n, 0);
+  s.outlier.assign(n, 0);
+
+  // Region T: the tiles' windows. Medians and residual energies are needed there.
+  const Roi T = s.box.grown(kTileGrow + kTile, W, H);
+  const int tw = T.width(), th = T.height();
+  std::vector<float> med(std::size_t(tw) * std::size_t(th) * 3, 0.0f);
+  std::vector<float> erel(std::size_t(tw) * std::size_t(th), 0.0f);
+  std::vector<std::uint8_t> eok(std::size_t(tw) * std::size_t(th), 0);
+  parallel_rows(T.y0, T.y1, nthreads, [&](int yy) {
+    float vals[3][9];
+    for (int x = T.x0; x < T.x1; ++x) {
+      const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
+      if (!y.finite(x, yy)) continue;
+      int k = 0;
+      double nb[3] = {0, 0, 0};
+      int nn = 0;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx, qy = yy + dy;
+          if (qx < 0 || qy < 0 || qx >= W || qy >= H || !y.finite(qx, qy)) continue;
+          const float* q = y.at(qx, qy);
+          for (int c = 0; c < 3; ++c) vals[c][k] = q[c];
+          ++k;
+          if (dx || dy) {
+            for (int c = 0; c < 3; ++c) nb[c] += q[c];
+            ++nn;
+          }
+        }
+      double my2 = 0;
+      for (int c = 0; c < 3; ++c) {
+        const float m = median_of(vals[c], k);
+        med[i * 3 + std::size_t(c)] = m;
+        my2 += double(m) * m;
+      }
+      my2 /= 3.0;
+      if (nn == 0) continue;
+      const float* p = y.at(x, yy);
+      double e = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double r = double(p[c]) - nb[c] / nn;
+        e += r * r;
+      }
+      // Var(y - mean of nn neighbours) = s^2 (1 + 1/nn).
+      erel[i] = float(e / 3.0 / (1.0 + 1.0 / nn) / (my2 + kRelativeEps));
+      eok[i] = 1;
+    }
+  });
+
+  // Robust scale per tile of the box: the median relative residual of the tile's window.
+  const int ntx = (s.box.width() + kTile - 1) / kTile, nty = (s.box.height() + kTile - 1) / kTile;
+  std::vector<float> tile_rel(std::size_t(ntx) * std::size_t(nty), 0.0f);
+  parallel_rows(0, nty, nthreads, [&](int ty) {
+    std::vector<float> buf;
+    for (int tx = 0; tx < ntx; ++tx) {
+      const int x0 = s.box.x0 + tx * kTile, y0 = s.box.y0 + ty * kTile;
+      const Roi win = Roi{x0, y0, x0 + kTile, y0 + kTile}.grown(kTileGrow, W, H);
+      buf.clear();
+      for (int yy = win.y0; yy < win.y1; ++yy)
+        for (int x = win.x0; x < win.x1; ++x) {
+          const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
+          if (eok[i]) buf.push_back(erel[i]);
+        }
+      tile_rel[std::size_t(ty) * std::size_t(ntx) + std::size_t(tx)] =
+          buf.empty() ? 0.0f : float(kChi2MedianToMean) * median_of(buf.data(), int(buf.size()));
+    }
+  });
+
+  // Differences at distance 1 and 2 over the box grown by the variance window.
+  const Roi V = s.box.grown(kVarianceRadius, W, H);
+  const int vw = V.width(), vh = V.height();
+  WindowSums e1(vw, vh), e2(vw, vh);
+  static const int dirs[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+  parallel_rows(V.y0, V.y1, nthreads, [&](int yy) {
+    for (int x = V.x0; x < V.x1; ++x) {
+      if (!y.finite(x, yy)) continue;
+      const float* p = y.at(x, yy);
+      for (int k = 1; k <= 2; ++k) {
+        double sum = 0;
+        int cnt = 0;
+        for (const auto& d : dirs) {
+          const int qx = x + k * d[0], qy = yy + k * d[1];
+          if (qx < 0 || qy < 0 || qx >= W || qy >= H || !y.finite(qx, qy)) continue;
+          const float* q = y.at(qx, qy);
+          for (int c = 0; c < 3; ++c) {
+            const double r = double(p[c]) - double(q[c]);
+            sum += r * r;
+          }
+          ++cnt;
+        }
+        if (cnt) (k == 1 ? e1 : e2).set(x - V.x0, yy - V.y0, sum / (6.0 * cnt), 1.0);
+      }
+    }
+  });
+  e1.sum_windows(kVarianceRadius, nthreads);
+  e2.sum_windows(kVarianceRadius, nthreads);
+
+  parallel_rows(s.box.y0, s.box.y1, nthreads, [&](int yy) {
+    for (int x = s.box.x0; x < s.box.x1; ++x) {
+      const std::size_t o = s.at(x, yy);
+      if (!y.finite(x, yy)) continue;
+      s.finite[o] = 1;
+      const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
+      double my2 = 0, dev = 0;
+      const float* p = y.at(x, yy);
+      for (int c = 0; c < 3; ++c) {
+        const float m = med[i * 3 + std::size_t(c)];
+        s.median[o * 3 + std::size_t(c)] = m;
+        my2 += double(m) * m;
+        dev += (double(p[c]) - m) * (double(p[c]) - m);
+      }
+      my2 /= 3.0;
+      dev /= 3.0;
+      const double rel = tile_rel[std::size_t((yy - s.box.y0) / kTile) * std::size_t(ntx) + std::size_t((x - s.box.x0) / kTile)];
+      const double robust = std::max(rel * (my2 + kRelativeEps), kFloorRelative * kFloorRelative * my2);
+      s.robust[o] = float(std::min(robust, 3.0e38));
+      s.outlier[o] = dev > kOutlierSigmas * kOutlierSigmas * robust ? 1 : 0;
+      const int vx = x - V.x0, vy = yy - V.y0;
+      const double v1 = e1.mean(vx, vy), v2 = e2.mean(vx, vy);
+      s.variance[o] = float(std::min(std::max(2.0 * v1 - v2, 0.0), 3.0e38));
+    }
+  });
+  return s;
+}
+
+}  // namespace mcr

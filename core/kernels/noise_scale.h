@@ -1,0 +1,47 @@
+#pragma once
+// Local noise scales of a noisy colour image, estimated from the image alone (no variance
+// pass, no second buffer), for the step back (prepare/step_back.h) and `auto`:
+//
+//   variance(p)  the variance of one pixel's noise (mean over R, G, B), from differences
+//                at two distances: V_k = mean over the (2*3+1)^2 window and 4 directions d
+//                of |y(q) - y(q + k d)|^2 / 2. For pixel-independent noise of variance s^2
+//                both are s^2 plus the signal's share, which a step edge doubles from k=1
+//                to k=2 and a ramp quadruples, so s^2 ~ 2 V_1 - V_2 (>= 0): edges cancel,
+//                ramps and a Blackman-Harris pixel filter's blur make it err low.
+//   median(p)    per-channel median of the finite pixels of the 3x3 neighbourhood.
+//   robust(p)    a scale sparse bright structure cannot inflate: the median, over a tile
+//                (4x4 pixels grown by 4), of the 8-neighbour high-pass residual energy
+//                relative to (median luminance^2 + 1e-3), times this pixel's
+//                (median luminance^2 + 1e-3), times 1.27 (median -> mean of a chi^2_3/3);
+//                at least (0.02 * median)^2: 2% is below what anyone sees, and a converged
+//                render then still has a scale.
+//   outlier(p)   |y(p) - median(p)|^2 > 16 robust(p): a firefly (or a one-pixel highlight).
+//
+// Non-finite pixels take no part in any neighbourhood; at a non-finite pixel every scale
+// is 0 and outlier is false. Deterministic: no reduction depends on the thread count.
+#include <cstdint>
+#include <vector>
+
+#include "image/image.h"
+
+namespace mcr {
+
+struct NoiseScales {
+  Roi box;                          // where the vectors below hold values, row-major
+  std::vector<float> variance;      // one per pixel
+  std::vector<float> robust;        // one per pixel
+  std::vector<float> median;        // three per pixel (RGB)
+  std::vector<std::uint8_t> finite; // the pixel's RGB is finite
+  std::vector<std::uint8_t> outlier;
+  std::size_t at(int x, int y) const {
+    return std::size_t(y - box.y0) * std::size_t(box.width()) + std::size_t(x - box.x0);
+  }
+};
+
+constexpr double kOutlierSigmas = 4.0;  // outlier: further than this many robust deviations
+
+// Scales for the pixels of `box` (clipped to the image); reads up to 5 pixels around it.
+// colour: RGB in its first three channels.
+NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads);
+
+}  // namespace mcr

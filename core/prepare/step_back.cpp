@@ -1,0 +1,119 @@
+#include "prepare/step_back.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "kernels/noise_scale.h"
+#include "kernels/window_sums.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+constexpr double kRelMseEps = 0.01;     // relMSE's denominator term
+constexpr double kRangeSigmas = 2.0;    // how far the blend may leave the 3x3 input range
+constexpr float kMax = 3.402823466e38f;
+
+double clamp_float(double v) { return std::min(std::max(v, -double(kMax)), double(kMax)); }
+
+}  // namespace
+
+StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int nthreads, Image& out) {
+  StepBackStats st;
+  const int W = input.width(), H = input.height();
+  const Roi roi = roi_in.clipped(W, H);
+  if (roi.empty()) return st;
+  const NoiseScales ns = estimate_noise_scales(input, roi, nthreads);
+  const int rw = roi.width(), rh = roi.height();
+
+  // The window sums of the blend weight's numerator and denominator, over the roi only
+  // (outside it the result is the input).
+  WindowSums num(rw, rh), den(rw, rh);
+  parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
+    for (int x = roi.x0; x < roi.x1; ++x) {
+      const std::size_t i = ns.at(x, y);
+      if (!ns.finite[i] || ns.outlier[i]) continue;
+      const float* m = &ns.median[i * 3];
+      const double w = 1.0 / ((double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0 + kRelMseEps);
+      const float* p = input.pixel(x, y);
+      const float* f = out.pixel(x, y);
+      double d2 = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(f[c]) - double(p[c]);
+        d2 += d * d;
+      }
+      num.set(x - roi.x0, y - roi.y0, w * ns.variance[i], 0.0);
+      den.set(x - roi.x0, y - roi.y0, std::min(w * d2 / 3.0, 1e300), 0.0);
+    }
+  });
+  num.sum_windows(radius, nthreads);
+  den.sum_windows(radius, nthreads);
+
+  std::vector<double> row_weight(std::size_t(rh), 0.0), row_input(std::size_t(rh), 0.0), row_count(std::size_t(rh), 0.0),
+      row_fire(std::size_t(rh), 0.0);
+  parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
+    const std::size_t ry = std::size_t(y - roi.y0);
+    for (int x = roi.x0; x < roi.x1; ++x) {
+      const std::size_t i = ns.at(x, y);
+      if (!ns.finite[i]) continue;  // the filter's (finite) value stays
+      float* f = out.pixel(x, y);
+      row_count[ry] += 1;
+      if (ns.outlier[i]) {
+        row_weight[ry] += 1;
+        row_fire[ry] += 1;
+        continue;
+      }
+      const float* p = input.pixel(x, y);
+      const float* m = &ns.median[i * 3];
+      const double n = num.value(x - roi.x0, y - roi.y0), d = den.value(x - roi.x0, y - roi.y0);
+      double a = d > 0 ? std::min(n / d, 1.0) : 1.0;
+      double dm = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double e = double(f[c]) - double(m[c]);
+        dm += e * e;
+      }
+      dm /= 3.0;
+      const double limit = kOutlierSigmas * kOutlierSigmas * double(ns.robust[i]);
+      if (dm > limit) a = std::min(a, limit / dm);
+      // The 3x3 input range (fireflies as their median), widened by kRangeSigmas.
+      double lo[3], hi[3];
+      for (int c = 0; c < 3; ++c) lo[c] = hi[c] = p[c];
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx, qy = y + dy;
+          if (!roi.contains(qx, qy)) continue;
+          const std::size_t j = ns.at(qx, qy);
+          if (!ns.finite[j]) continue;
+          const float* q = ns.outlier[j] ? &ns.median[j * 3] : input.pixel(qx, qy);
+          for (int c = 0; c < 3; ++c) {
+            lo[c] = std::min(lo[c], double(q[c]));
+            hi[c] = std::max(hi[c], double(q[c]));
+          }
+        }
+      const double widen = kRangeSigmas * std::sqrt(double(ns.robust[i]));
+      for (int c = 0; c < 3; ++c) {
+        const double v = double(p[c]) + a * (double(f[c]) - double(p[c]));
+        f[c] = float(clamp_float(std::min(std::max(v, lo[c] - widen), hi[c] + widen)));
+      }
+      row_weight[ry] += a;
+      if (a < 0.5) row_input[ry] += 1;
+    }
+  });
+  double wsum = 0, isum = 0, count = 0, fire = 0;
+  for (std::size_t r = 0; r < row_count.size(); ++r) {
+    wsum += row_weight[r];
+    isum += row_input[r];
+    count += row_count[r];
+    fire += row_fire[r];
+  }
+  if (count > 0) {
+    st.mean_weight = wsum / count;
+    st.input_share = isum / count;
+  }
+  st.fireflies = std::size_t(fire);
+  return st;
+}
+
+}  // namespace mcr

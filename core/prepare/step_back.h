@@ -1,0 +1,37 @@
+#pragma once
+// The step back: after a filter ran, its result is blended toward the input wherever it
+// is not estimated to beat it, so a clean render is left nearly as it was and a filter's
+// bias (a highlight spread into a dark neighbour, a shadow averaged away) is undone.
+//
+// For a result f of the noisy input y = x + n (noise variance s^2 per pixel), the blend
+// y + a (f - y) has expected squared error a^2 E|f-y|^2 - 2 a s^2 (1 - div f) + s^2
+// (Stein's lemma), smallest at a = s^2 (1 - div f) / E|f-y|^2. With div f ~ 0 (a filter
+// that averages many pixels) a = s^2 / |f-y|^2, taken over a (2 radius + 1)^2 window,
+// each pixel weighted by 1 / (median luminance^2 + 0.01) as relMSE weighs it, and
+// clamped to [0, 1]. Then, per pixel (kernels/noise_scale.h for the scales):
+//   - a firefly (outlier) takes the filter's value: removing it is the point;
+//   - elsewhere a <= 16 robust / |f - median|^2: the result may not leave the 3x3 median
+//     by more than 4 robust deviations (it would have pulled light from a neighbour);
+//   - the blend is clamped to the 3x3 range of the input (fireflies read as their
+//     median) widened by 2 robust deviations.
+// With s^2 estimated within 2x of the truth the blend is never worse than the input in
+// expectation; the estimate errs low on ramps and blur (less filtering), high on sharp
+// highlights (which the per-pixel limits catch).
+// Non-finite input pixels keep the filter's value and take no part in any window.
+#include <cstddef>
+
+#include "image/image.h"
+
+namespace mcr {
+
+struct StepBackStats {
+  double mean_weight = 1.0;   // mean a over the roi's finite pixels (1 = the filter's result)
+  double input_share = 0.0;   // fraction of those pixels with a < 0.5
+  std::size_t fireflies = 0;  // outliers given to the filter
+};
+
+// input: the colour the filter was given (RGB in its first channels, the frame's size);
+// out: the filter's RGB result, changed inside roi only.
+StepBackStats step_back(const Image& input, const Roi& roi, int radius, int nthreads, Image& out);
+
+}  // namespace mcr
