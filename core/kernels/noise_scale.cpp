@@ -113,34 +113,30 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
     }
   });
 
-  // Differences at distance 1 and 2 over the box grown by the variance window.
+  // z(q) = mean over 4 directions d and R, G, B of (y(q) - y(q - d)) (y(q) - y(q + d)), over
+  // the box grown by the variance window.
   const Roi V = s.box.grown(kVarianceRadius, W, H);
-  const int vw = V.width(), vh = V.height();
-  WindowSums e1(vw, vh), e2(vw, vh);
+  WindowSums z(V.width(), V.height());
   static const int dirs[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
   parallel_rows(V.y0, V.y1, nthreads, [&](int yy) {
     for (int x = V.x0; x < V.x1; ++x) {
       if (!y.finite(x, yy)) continue;
       const float* p = y.at(x, yy);
-      for (int k = 1; k <= 2; ++k) {
-        double sum = 0;
-        int cnt = 0;
-        for (const auto& d : dirs) {
-          const int qx = x + k * d[0], qy = yy + k * d[1];
-          if (qx < 0 || qy < 0 || qx >= W || qy >= H || !y.finite(qx, qy)) continue;
-          const float* q = y.at(qx, qy);
-          for (int c = 0; c < 3; ++c) {
-            const double r = double(p[c]) - double(q[c]);
-            sum += r * r;
-          }
-          ++cnt;
-        }
-        if (cnt) (k == 1 ? e1 : e2).set(x - V.x0, yy - V.y0, sum / (6.0 * cnt), 1.0);
+      double sum = 0;
+      int cnt = 0;
+      for (const auto& d : dirs) {
+        const int ax = x - d[0], ay = yy - d[1], bx = x + d[0], by = yy + d[1];
+        if (ax < 0 || ay < 0 || ax >= W || ay >= H || bx < 0 || by < 0 || bx >= W || by >= H) continue;
+        if (!y.finite(ax, ay) || !y.finite(bx, by)) continue;
+        const float* a = y.at(ax, ay);
+        const float* b = y.at(bx, by);
+        for (int c = 0; c < 3; ++c) sum += (double(p[c]) - a[c]) * (double(p[c]) - b[c]);
+        ++cnt;
       }
+      if (cnt) z.set(x - V.x0, yy - V.y0, sum / (3.0 * cnt), 1.0);
     }
   });
-  e1.sum_windows(kVarianceRadius, nthreads);
-  e2.sum_windows(kVarianceRadius, nthreads);
+  z.sum_windows(kVarianceRadius, nthreads);
 
   parallel_rows(s.box.y0, s.box.y1, nthreads, [&](int yy) {
     for (int x = s.box.x0; x < s.box.x1; ++x) {
@@ -150,11 +146,25 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
       double my2 = 0, dev = 0;
       const float* p = y.at(x, yy);
+      float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+      bool any = false;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx, qy = yy + dy;
+          if ((!dx && !dy) || qx < 0 || qy < 0 || qx >= W || qy >= H || !y.finite(qx, qy)) continue;
+          const float* q = y.at(qx, qy);
+          for (int c = 0; c < 3; ++c) {
+            lo[c] = any ? std::min(lo[c], q[c]) : q[c];
+            hi[c] = any ? std::max(hi[c], q[c]) : q[c];
+          }
+          any = true;
+        }
       for (int c = 0; c < 3; ++c) {
         const float m = med[i * 3 + std::size_t(c)];
         s.median[o * 3 + std::size_t(c)] = m;
         my2 += double(m) * m;
-        dev += (double(p[c]) - m) * (double(p[c]) - m);
+        const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
+        dev += out * out;
       }
       my2 /= 3.0;
       dev /= 3.0;
@@ -162,9 +172,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       const double robust = std::max(rel * (my2 + kRelativeEps), kFloorRelative * kFloorRelative * my2);
       s.robust[o] = float(std::min(robust, 3.0e38));
       s.outlier[o] = dev > kOutlierSigmas * kOutlierSigmas * robust ? 1 : 0;
-      const int vx = x - V.x0, vy = yy - V.y0;
-      const double v1 = e1.mean(vx, vy), v2 = e2.mean(vx, vy);
-      s.variance[o] = float(std::min(std::max(2.0 * v1 - v2, 0.0), 3.0e38));
+      s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0), 0.0), 3.0e38));
     }
   });
   return s;

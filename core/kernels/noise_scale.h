@@ -2,12 +2,13 @@
 // Local noise scales of a noisy colour image, estimated from the image alone (no variance
 // pass, no second buffer), for the step back (prepare/step_back.h) and `auto`:
 //
-//   variance(p)  the variance of one pixel's noise (mean over R, G, B), from differences
-//                at two distances: V_k = mean over the (2*3+1)^2 window and 4 directions d
-//                of |y(q) - y(q + k d)|^2 / 2. For pixel-independent noise of variance s^2
-//                both are s^2 plus the signal's share, which a step edge doubles from k=1
-//                to k=2 and a ramp quadruples, so s^2 ~ 2 V_1 - V_2 (>= 0): edges cancel,
-//                ramps and a Blackman-Harris pixel filter's blur make it err low.
+//   variance(p)  the variance of one pixel's noise (mean over R, G, B): the mean over the
+//                (2*3+1)^2 window, 4 directions d and R, G, B of
+//                (y(q) - y(q - d)) (y(q) - y(q + d)), at least 0. For pixel-independent
+//                noise of variance s^2 its expectation is s^2; a step edge adds exactly 0
+//                (one factor is 0 on either side of it), a ramp of slope g adds -g^2, so
+//                edges cancel and smooth shading or a pixel filter's blur make it err low.
+//                A one-pixel peak counts as noise.
 //   median(p)    per-channel median of the finite pixels of the 3x3 neighbourhood.
 //   robust(p)    a scale sparse bright structure cannot inflate: the median, over a tile
 //                (4x4 pixels grown by 4), of the 8-neighbour high-pass residual energy
@@ -15,7 +16,9 @@
 //                (median luminance^2 + 1e-3), times 1.27 (median -> mean of a chi^2_3/3);
 //                at least (0.02 * median)^2: 2% is below what anyone sees, and a converged
 //                render then still has a scale.
-//   outlier(p)   |y(p) - median(p)|^2 > 16 robust(p): a firefly (or a one-pixel highlight).
+//   outlier(p)   y(p) lies beyond the range of its 8 finite neighbours by more than 4
+//                robust deviations (mean over R, G, B of the squared excess > 16 robust(p)):
+//                a firefly (or a one-pixel highlight); a block's corner is not one.
 //
 // Non-finite pixels take no part in any neighbourhood; at a non-finite pixel every scale
 // is 0 and outlier is false. Deterministic: no reduction depends on the thread count.

@@ -81,6 +81,7 @@ LoadedScene synthetic_scene(int frames, int w = 13, int h = 9) {
 
 std::unique_ptr<Filter> box(int radius) {
   auto f = make_filter("box");
+  testutil::without_step_back(*f);
   f->set("radius", std::int64_t(radius));
   f->commit();
   return f;

@@ -86,8 +86,15 @@ struct Result {
 
 // Sets the parameters (name, value pairs in any container) on a fresh filter object,
 // commits and runs it once.
+// The filter's own algorithm, as its oracles define it: the step back (which blends the
+// result toward the input, prepare/step_back.h) off unless a test sets it.
+inline void without_step_back(Filter& f) {
+  if (f.params().has("step_back")) f.set("step_back", false);
+}
+
 template <class ParamList>
 Result run_filter(Filter& f, const Frame& frame, const ParamList& params, int nthreads = 0, Roi roi = {}) {
+  without_step_back(f);
   for (const auto& [k, v] : params) f.set(k, v);
   f.commit();
   ExecOptions eo;

@@ -1,0 +1,148 @@
+// kernels/noise_scale: the noise estimate against images whose noise is known: synthetic
+// noise of a given variance on steps and ramps, and the sample renders against their
+// 2048-spp references (the same scene at several sample counts).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "io/frame_reader.h"
+#include "io/sample_manifest.h"
+#include "kernels/noise_scale.h"
+
+namespace mcr {
+namespace {
+
+// Blocks of 16 px at random levels in [0.5, 2] (steps in every direction), plus a ramp.
+Image blocks(int w, int h, unsigned seed, double sigma) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> level(0.5f, 2.0f);
+  std::normal_distribution<float> noise(0.0f, float(sigma));
+  std::vector<float> lv(std::size_t((w / 16 + 1) * (h / 16 + 1)) * 3);
+  for (float& v : lv) v = level(rng);
+  Image im(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float base = lv[std::size_t(((y / 16) * (w / 16 + 1) + x / 16) * 3 + c)] + 0.004f * float(x);
+        im.at(x, y, c) = base + (sigma > 0 ? noise(rng) : 0.0f);
+      }
+  return im;
+}
+
+double mean_over(const std::vector<float>& v) {
+  double s = 0;
+  for (float x : v) s += x;
+  return s / double(v.size());
+}
+
+TEST(NoiseScale, WhiteNoiseOnStepsAndRampsGivesItsVariance) {
+  for (double sigma : {0.02, 0.1, 0.3}) {
+    SCOPED_TRACE(sigma);
+    const Image im = blocks(128, 96, 7, sigma);
+    const NoiseScales s = estimate_noise_scales(im, Roi::all(128, 96), 2);
+    EXPECT_NEAR(mean_over(s.variance) / (sigma * sigma), 1.0, 0.15);
+    // The robust scale is a median: within 35% of the variance for Gaussian noise.
+    EXPECT_NEAR(mean_over(s.robust) / (sigma * sigma), 1.0, 0.35);
+  }
+}
+
+TEST(NoiseScale, EdgesOfANoiseFreeImageAreNotNoise) {
+  const Image clean = blocks(128, 96, 7, 0.0);
+  const NoiseScales s = estimate_noise_scales(clean, Roi::all(128, 96), 1);
+  // The plain high-pass energy (the 8-neighbour residual) these steps would give:
+  double hp = 0;
+  int n = 0;
+  for (int y = 1; y < 95; ++y)
+    for (int x = 1; x < 127; ++x) {
+      for (int c = 0; c < 3; ++c) {
+        double m = 0;
+        for (int dy = -1; dy <= 1; ++dy)
+          for (int dx = -1; dx <= 1; ++dx)
+            if (dx || dy) m += clean.at(x + dx, y + dy, c);
+        hp += std::pow(clean.at(x, y, c) - m / 8, 2) / 3;
+      }
+      ++n;
+    }
+  hp /= n;
+  EXPECT_LT(mean_over(s.variance), 0.1 * hp);
+  EXPECT_EQ(std::count(s.outlier.begin(), s.outlier.end(), 1), 0);
+}
+
+TEST(NoiseScale, FireflyIsAnOutlierAndDoesNotInflateTheRobustScale) {
+  Image im = blocks(64, 64, 3, 0.05);
+  for (auto [x, y] : {std::pair{20, 20}, std::pair{22, 21}, std::pair{40, 9}})
+    for (int c = 0; c < 3; ++c) im.at(x, y, c) = 50.0f;
+  const NoiseScales s = estimate_noise_scales(im, Roi::all(64, 64), 2);
+  for (int y = 0; y < 64; ++y)
+    for (int x = 0; x < 64; ++x) {
+      const bool fire = im.at(x, y, 0) == 50.0f;
+      EXPECT_EQ(s.outlier[s.at(x, y)], fire ? 1 : 0) << x << "," << y;
+      if (!fire) EXPECT_LT(s.robust[s.at(x, y)], 4 * 0.05 * 0.05 + 0.02 * 0.02 * 4) << x << "," << y;
+    }
+}
+
+TEST(NoiseScale, NonFinitePixelsTakeNoPart) {
+  Image im = blocks(32, 32, 5, 0.05);
+  const NoiseScales ref = estimate_noise_scales(im, Roi::all(32, 32), 1);
+  im.at(10, 10, 1) = std::numeric_limits<float>::quiet_NaN();
+  im.at(11, 10, 0) = std::numeric_limits<float>::infinity();
+  const NoiseScales s = estimate_noise_scales(im, Roi::all(32, 32), 1);
+  EXPECT_EQ(s.finite[s.at(10, 10)], 0);
+  EXPECT_EQ(s.finite[s.at(11, 10)], 0);
+  for (std::size_t i = 0; i < s.variance.size(); ++i) {
+    EXPECT_TRUE(std::isfinite(s.variance[i]) && std::isfinite(s.robust[i]));
+  }
+  // Far away (beyond every window) nothing changed.
+  EXPECT_EQ(s.variance[s.at(28, 28)], ref.variance[ref.at(28, 28)]);
+}
+
+// The sample renders, against their references: the error of the noisy render is its
+// noise. Per 16x16 tile, the estimate within 2x of |noisy - reference|^2 at the median
+// tile, for 1, 4 and 16 spp, and it falls with the sample count as the noise does.
+TEST(NoiseScale, SampleRendersAgainstTheirReferences) {
+  const std::vector<SampleScene> scenes = load_sample_manifest(std::string(MCRECON_SOURCE_DIR) + "/samples/data");
+  int checked = 0;
+  for (const SampleScene& sc : scenes) {
+    if (sc.is_sequence()) continue;
+    const Frame ref = read_frame(sc.reference);
+    const Image& r = ref.image(Role::Colour);
+    std::map<int, double> median_estimate;
+    for (const auto& [spp, path] : sc.noisy) {
+      if (spp > 16) continue;
+      SCOPED_TRACE(path);
+      const Frame f = read_frame(path);
+      const Image& y = f.image(Role::Colour);
+      const NoiseScales s = estimate_noise_scales(y, Roi::all(y.width(), y.height()), 0);
+      std::vector<double> ratio, est;
+      for (int ty = 0; ty + 16 <= y.height(); ty += 16)
+        for (int tx = 0; tx + 16 <= y.width(); tx += 16) {
+          double e = 0, t = 0;
+          for (int yy = ty; yy < ty + 16; ++yy)
+            for (int xx = tx; xx < tx + 16; ++xx) {
+              e += s.variance[s.at(xx, yy)];
+              for (int c = 0; c < 3; ++c) t += std::pow(double(y.at(xx, yy, c)) - r.at(xx, yy, c), 2) / 3;
+            }
+          if (t > 0) ratio.push_back(std::log2(std::max(e, 1e-30) / t));
+          est.push_back(e);
+        }
+      std::nth_element(ratio.begin(), ratio.begin() + long(ratio.size() / 2), ratio.end());
+      EXPECT_LT(std::abs(ratio[ratio.size() / 2]), 1.0) << "median log2(estimate / true) per tile";
+      std::nth_element(est.begin(), est.begin() + long(est.size() / 2), est.end());
+      median_estimate[spp] = est[est.size() / 2];
+      ++checked;
+    }
+    for (const auto& [spp, m] : median_estimate)
+      if (median_estimate.count(spp * 4)) {
+        const double drop = m / median_estimate[spp * 4];
+        EXPECT_GT(drop, 2.0) << sc.name << " " << spp << " -> " << spp * 4 << " spp";
+        EXPECT_LT(drop, 8.0) << sc.name << " " << spp << " -> " << spp * 4 << " spp";
+      }
+  }
+  EXPECT_GE(checked, 9);
+}
+
+}  // namespace
+}  // namespace mcr

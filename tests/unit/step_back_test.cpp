@@ -1,0 +1,160 @@
+// prepare/step_back: the blend toward the input, against images whose truth is known.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "feature_filter_testutil.h"
+#include "filters/registry.h"
+#include "prepare/step_back.h"
+
+namespace mcr {
+namespace {
+
+// Blocks of 12 px at levels in [0.05, 2] (dark next to bright) plus a ramp; noise sigma
+// relative to the level (as Monte Carlo noise roughly is).
+Image scene(int w, int h, double rel_sigma, unsigned seed, Image* clean_out = nullptr) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> level(0.05f, 2.0f);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  std::vector<float> lv(std::size_t((w / 12 + 1) * (h / 12 + 1)) * 3);
+  for (float& v : lv) v = level(rng);
+  Image clean(w, h, 3), noisy(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float v = lv[std::size_t(((y / 12) * (w / 12 + 1) + x / 12) * 3 + c)] * (1.0f + 0.003f * float(x));
+        clean.at(x, y, c) = v;
+        noisy.at(x, y, c) = v * (1.0f + float(rel_sigma) * noise(rng));
+      }
+  if (clean_out) *clean_out = clean;
+  return noisy;
+}
+
+Image box_blur(const Image& in, int r) {
+  Image out(in.width(), in.height(), 3);
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        double s = 0;
+        int n = 0;
+        for (int yy = std::max(0, y - r); yy <= std::min(in.height() - 1, y + r); ++yy)
+          for (int xx = std::max(0, x - r); xx <= std::min(in.width() - 1, x + r); ++xx) {
+            s += in.at(xx, yy, c);
+            ++n;
+          }
+        out.at(x, y, c) = float(s / n);
+      }
+  return out;
+}
+
+// relMSE as the metrics define it.
+double relmse(const Image& a, const Image& ref) {
+  double s = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(a.at(x, y, c)) - ref.at(x, y, c);
+        s += d * d / (double(ref.at(x, y, c)) * ref.at(x, y, c) + 0.01);
+      }
+  return s / (3.0 * double(a.pixel_count()));
+}
+
+TEST(StepBack, ACleanRenderStaysAsItWas) {
+  Image clean;
+  scene(96, 72, 0.0, 1, &clean);
+  const Image blurred = box_blur(clean, 3);
+  Image out = blurred;
+  step_back(clean, Roi::all(96, 72), 4, 2, out);
+  EXPECT_LT(relmse(out, clean), 0.01 * relmse(blurred, clean));
+}
+
+TEST(StepBack, TheTruthAsTheResultIsKept) {
+  Image clean;
+  const Image noisy = scene(96, 72, 0.3, 2, &clean);
+  Image out = clean;
+  const StepBackStats st = step_back(noisy, Roi::all(96, 72), 4, 2, out);
+  EXPECT_LT(relmse(out, clean), 0.2 * relmse(noisy, clean));
+  EXPECT_GT(st.mean_weight, 0.8);
+}
+
+TEST(StepBack, ABiasedFilterIsNoWorseThanTheInputOrItself) {
+  for (double sigma : {0.03, 0.1, 0.3, 1.0}) {
+    SCOPED_TRACE(sigma);
+    Image clean;
+    const Image noisy = scene(96, 72, sigma, 3, &clean);
+    const Image blurred = box_blur(noisy, 4);  // averages across every block edge
+    Image out = blurred;
+    step_back(noisy, Roi::all(96, 72), 4, 2, out);
+    EXPECT_LT(relmse(out, clean), relmse(noisy, clean));
+    EXPECT_LT(relmse(out, clean), relmse(blurred, clean));
+  }
+}
+
+TEST(StepBack, AFireflyGoesAndItsLightStaysWhereItWas) {
+  Image clean;
+  Image noisy = scene(48, 48, 0.05, 4, &clean);
+  for (int c = 0; c < 3; ++c) noisy.at(30, 30, c) = 1000.0f;
+  const Image blurred = box_blur(noisy, 2);
+  Image out = blurred;
+  const StepBackStats st = step_back(noisy, Roi::all(48, 48), 4, 1, out);
+  EXPECT_EQ(st.fireflies, 1u);
+  for (int c = 0; c < 3; ++c) EXPECT_EQ(out.at(30, 30, c), blurred.at(30, 30, c));  // the filter's value
+  for (int y = 28; y <= 32; ++y)
+    for (int x = 28; x <= 32; ++x)
+      if (x != 30 || y != 30)
+        for (int c = 0; c < 3; ++c) EXPECT_LT(out.at(x, y, c), clean.at(x, y, c) * 1.5f + 0.01f) << x << "," << y;
+}
+
+TEST(StepBack, NonFiniteInputKeepsTheResultAndOnlyTheRegionChanges) {
+  Image noisy = scene(40, 30, 0.2, 5);
+  noisy.at(12, 12, 0) = std::numeric_limits<float>::quiet_NaN();
+  noisy.at(13, 12, 2) = -std::numeric_limits<float>::infinity();
+  Image blurred = box_blur(noisy, 2);
+  for (int c = 0; c < 3; ++c) blurred.at(12, 12, c) = blurred.at(13, 12, c) = 0.5f;  // as finish() leaves them
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x)
+      for (int c = 0; c < 3; ++c)
+        if (!std::isfinite(blurred.at(x, y, c))) blurred.at(x, y, c) = 0.5f;
+  Image out = blurred;
+  const Roi roi{5, 5, 30, 25};
+  step_back(noisy, roi, 4, 2, out);
+  for (int y = 0; y < 30; ++y)
+    for (int x = 0; x < 40; ++x)
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_TRUE(std::isfinite(out.at(x, y, c)));
+        if (!roi.contains(x, y) || (y == 12 && (x == 12 || x == 13)))
+          EXPECT_EQ(out.at(x, y, c), blurred.at(x, y, c)) << x << "," << y;
+      }
+}
+
+// Through a filter: on by default, noted, and off gives the filter's own result.
+TEST(StepBack, EveryImageFilterTakesItByDefault) {
+  const Frame f = testutil::colour_frame(scene(40, 30, 0.2, 6));
+  for (const std::string& name : filter_names()) {
+    auto on = make_filter(name);
+    if (on->info().temporal) {
+      EXPECT_FALSE(on->params().has("step_back")) << name;
+      continue;
+    }
+    SCOPED_TRACE(name);
+    ASSERT_TRUE(on->params().get_bool("step_back"));
+    if (!on->missing_passes(f).empty()) continue;
+    on->commit();
+    const Image a = on->execute(f);
+    bool noted = false;
+    for (const std::string& n : on->notes()) noted = noted || n.rfind("step_back:", 0) == 0;
+    EXPECT_TRUE(noted);
+    auto off = make_filter(name);
+    off->set("step_back", false);
+    off->commit();
+    const Image b = off->execute(f);
+    Image expect = b;
+    step_back(f.image(Role::Colour), Roi::all(40, 30), 4, 0, expect);
+    EXPECT_EQ(a.storage(), expect.storage());
+  }
+}
+
+}  // namespace
+}  // namespace mcr
