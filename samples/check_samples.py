@@ -8,7 +8,11 @@ Checks: every file listed exists and has the expected channels; no NaN/Inf in an
 Combined is neither black nor blown out; the animation's Vector X/Y is non-zero on frames
 after the first. Prints relMSE = mean((x - r)^2 / (r^2 + 0.01)) over Combined RGB of every
 noisy level against its reference (per frame and averaged for the sequence), and the ratio
-between successive levels (about 4 for 4x the samples). Exit status 1 on any failure.
+between successive levels (about 4 for 4x the samples). Half buffers (`halves`: two spp/2
+renders with the level's seed and sample offsets 0 and spp/2) must average to the level's file
+in every pass Cycles accumulates; Depth and Position, which Cycles writes on sample 0 only, must
+be the level's in half 0 and unwritten (Depth 1e10, Position 0) in half 1.
+Exit status 1 on any failure.
 """
 import argparse
 import json
@@ -68,6 +72,46 @@ def check_file(path, passes):
     return names, pix
 
 
+# Passes Cycles writes on the render's first sample (index 0) only: with sample_offset > 0 they
+# stay at their clear value.
+FIRST_SAMPLE_ONLY = {"Depth": 1e10, "Position": 0.0}
+
+
+def check_halves(data, sc, spp, files):
+    """Mean of the two half buffers against the level's own file, channel by channel."""
+    names, full = read(os.path.join(data, sc["noisy"][spp]))
+    halves = [read(os.path.join(data, f)) for f in files]
+    if names is None or any(h[0] is None for h in halves):
+        return
+    if len(files) != 2 or any(h[0] != names for h in halves):
+        fail(f"{sc['name']} {spp} spp halves: want 2 files with the level's channels, got {files}")
+        return
+    for f in files:
+        check_file(os.path.join(data, f), sc["noisy_passes"])
+    avg = (halves[0][1] + halves[1][1]) / 2
+    worst, worst_rgb = 0.0, 0.0
+    for i, c in enumerate(names):
+        pas = c.split(".")[1]
+        if pas in FIRST_SAMPLE_ONLY:
+            if not (np.array_equal(halves[0][1][..., i], full[..., i])
+                    and np.all(halves[1][1][..., i] == np.float32(FIRST_SAMPLE_ONLY[pas]))):
+                fail(f"{sc['name']} halves: {c} is not the level's in half 0 and "
+                     f"{FIRST_SAMPLE_ONLY[pas]:g} in half 1")
+            continue
+        d = np.abs(avg[..., i] - full[..., i])
+        # Each file is rounded to half floats (colour passes): allow 2 half-float steps.
+        tol = 2.0 ** -9 * np.maximum(np.abs(full[..., i]), 2.0 ** -14) + 1e-6
+        if (d > tol).any():
+            fail(f"{sc['name']} halves: mean of the halves differs from {sc['noisy'][spp]} in {c} "
+                 f"by up to {float(d.max()):.3g} at {int((d > tol).sum())} pixels")
+        worst = max(worst, float((d / np.maximum(np.abs(full[..., i]), 1e-3)).max()))
+        if c in RGB:
+            worst_rgb = max(worst_rgb, float(d.max()))
+    print(f"{sc['name']}: mean of the {spp}-spp halves = {spp}-spp file up to {worst_rgb:.2g} "
+          f"in Combined RGB (max relative difference over accumulated passes {worst:.2g}); "
+          f"half 1 has no Depth/Position (Cycles writes them on sample 0 only)")
+
+
 def frame_paths(data, pattern, frames):
     return [(f, os.path.join(data, pattern.replace("####", f"{f:04d}")))
             for f in range(frames[0], frames[1] + 1)]
@@ -85,6 +129,9 @@ def main():
     total_bytes = 0
     for sc in manifest["scenes"]:
         name, seq = sc["name"], sc["kind"] == "sequence"
+        if sc.get("split") not in ("tune", "report"):
+            fail(f"{name}: split is {sc.get('split')!r}, want 'tune' or 'report'")
+        print(f"{name}: split {sc.get('split')}, indirect clamp {sc['cycles']['clamp_indirect']:g}")
         frames = sc.get("frames", [1, 1])
         ref_pat = sc["reference"]
         refs = {}
@@ -119,6 +166,10 @@ def main():
                 if args.png and f in (None, frames[0]) and int(spp) <= 4:
                     png(path, args.png)
             table.append((name, int(spp), float(np.mean(errs)), len(errs)))
+            if spp in sc.get("halves", {}):
+                for f in sc["halves"][spp]:
+                    total_bytes += os.path.getsize(os.path.join(args.data, f))
+                check_halves(args.data, sc, spp, sc["halves"][spp])
             if vec and spp == min(sc["noisy"], key=int):
                 vx = np.array([v[1] for v in vec])
                 vy = np.array([v[2] for v in vec])

@@ -29,8 +29,23 @@ SCENES = {
                      "blurred foreground objects and background columns, wall and bokeh bulbs."),
     "anim": ("sequence", "16-frame keyframed camera truck/pan through a textured room with a table, "
                          "shelf and spheres; a spinning cube adds object motion."),
+    "sunlit": ("still", "Attic lit by the sun through a narrow window slit (hard patch on the floor) "
+                        "and a weak sky; brick and wave-striped walls, plank floor, polished gold "
+                        "sphere in the sun (tiny, very bright highlight), rough steel ring, clay "
+                        "Suzanne."),
+    "showroom": ("still", "Showroom under a procedural sky and a sun: car paint with flakes, "
+                          "brushed (anisotropic) steel, walnut, and glass spheres whose caustics "
+                          "are rare bright samples (indirect clamp off: fireflies)."),
+    "wall": ("still", "A flat plastered brick wall filling the frame, seen straight on by an "
+                      "orthographic camera (constant Normal and Depth passes), grazing area light "
+                      "and the soft shadow of a pole outside the view; no depth of field."),
 }
-ORDER = ["room", "glossy", "dof", "anim"]
+ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall"]
+# Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
+SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
+         "sunlit": "report", "showroom": "report", "wall": "report"}
+# Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
+HALVES = {"sunlit": [16], "showroom": [16], "wall": [16]}
 
 # Channel groups Blender writes (view layer "ViewLayer", compositing off).
 NOISY_PASSES = ["Combined", "Denoising Albedo", "Denoising Depth", "Denoising Normal", "Depth",
@@ -79,6 +94,9 @@ def run_scene(args, name, counter, total):
            "--width", str(w), "--height", str(h), "--threads", str(args.threads)]
     if seq:
         cmd += ["--frames", args.frames]
+    halves = [h for h in HALVES.get(name, []) if h in spp]
+    if halves:
+        cmd += ["--halves", ",".join(map(str, halves))]
     log_dir = os.path.join(HERE, "render_tmp", "logs")
     os.makedirs(log_dir, exist_ok=True)
     log_path = os.path.join(log_dir, f"{name}.log")
@@ -94,7 +112,7 @@ def run_scene(args, name, counter, total):
                 rec = json.loads(line[len("MCRECON_FILE "):])
                 records.append(rec)
                 counter[0] += 1
-                what = "ref" if rec["kind"] == "ref" else "noisy"
+                what = rec["kind"] if rec["kind"] != "half" else f"half {rec['half']} of {rec['of_spp']}"
                 frame = f" frame {rec['frame']:2d}" if rec["frame"] is not None else ""
                 print(f"[{counter[0]}/{total}] {name} {rec['spp']} spp ({what}){frame} ... "
                       f"{rec['seconds']:.1f} s", flush=True)
@@ -115,6 +133,8 @@ def manifest_entry(name, records, info, wall, out_root):
     seq = kind == "sequence"
     noisy = sorted({r["spp"] for r in records if r["kind"] == "noisy"})
     refs = [r for r in records if r["kind"] == "ref"]
+    halves = sorted((r for r in records if r["kind"] == "half"),
+                    key=lambda r: (r["of_spp"], r["half"]))
 
     def rel(fname):
         return f"{name}/{fname}"
@@ -137,13 +157,16 @@ def manifest_entry(name, records, info, wall, out_root):
             res[str(key)] = vals if seq else vals[0]
         return res
 
-    e = {"name": name, "kind": kind, "description": desc,
+    e = {"name": name, "kind": kind, "description": desc, "split": SPLIT[name],
          "width": info["width"], "height": info["height"]}
     if seq:
         e["frames"] = info["frames"]
         e["fps"] = info["fps"]
     e["noisy"] = {str(s): pattern(s) for s in noisy}
     e["noisy_passes"] = NOISY_PASSES
+    if halves:
+        e["halves"] = {str(s): [rel(r["file"]) for r in halves if r["of_spp"] == s]
+                       for s in sorted({r["of_spp"] for r in halves})}
     if refs:
         e["reference"] = pattern("ref")
         e["reference_spp"] = refs[0]["spp"]
@@ -152,6 +175,10 @@ def manifest_entry(name, records, info, wall, out_root):
     e["blender_wall_seconds"] = round(wall, 1)
     e["seeds"] = per_key(lambda r: r["seed"])
     e["file_bytes"] = per_key(size)
+    if halves:
+        e["halves_render_seconds"] = {r["file"]: r["seconds"] for r in halves}
+        e["halves_file_bytes"] = {r["file"]: size(r) for r in halves}
+        e["halves_sample_offsets"] = {r["file"]: r["sample_offset"] for r in halves}
     e["camera"] = info["camera"]
     e["blender_version"] = info["blender_version"]
     e["cycles"] = info["cycles"]
@@ -179,7 +206,8 @@ def main():
         if SCENES[n][0] == "sequence":
             total += nframes * (len(args.anim_spp) + (args.anim_ref_spp > 0))
         else:
-            total += len(args.spp) + (args.ref_spp > 0)
+            total += len(args.spp) + (args.ref_spp > 0) + \
+                2 * len([h for h in HALVES.get(n, []) if h in args.spp])
     os.makedirs(args.out, exist_ok=True)
     man_path = os.path.join(args.out, "manifest.json")
     manifest = {"scenes": []}
@@ -195,6 +223,8 @@ def main():
         entry = manifest_entry(n, records, info, wall, args.out)
         scenes = {s["name"]: s for s in manifest.get("scenes", [])}
         scenes[n] = entry
+        for s in scenes.values():  # entries written before the split existed
+            s["split"] = SPLIT.get(s["name"], s.get("split", "report"))
         manifest["scenes"] = [scenes[k] for k in ORDER if k in scenes] + \
             [v for k, v in scenes.items() if k not in ORDER]
         manifest["generator"] = "samples/render_samples.py"

@@ -25,6 +25,7 @@ which render_samples.py turns into progress lines and the manifest.
 
 import argparse
 import json
+import math
 import os
 import sys
 import time
@@ -63,6 +64,10 @@ def parse_args(scene_name, default_size, sequence=False):
     p.add_argument("--width", type=int, default=default_size[0])
     p.add_argument("--height", type=int, default=default_size[1])
     p.add_argument("--threads", type=int, default=0, help="render threads, 0 = all cores")
+    p.add_argument("--halves", type=_int_list, default=[],
+                   help="comma-separated spp levels also written as two half buffers "
+                        "(<scene>_<spp>spp_half0/1.exr: spp/2 samples each, the level's seed, "
+                        "sample offsets 0 and spp/2)")
     if sequence:
         p.add_argument("--frames", type=_frame_range, default=(1, 16),
                        help="frame range, e.g. 1-16")
@@ -95,7 +100,7 @@ def reset_scene():
     return bpy.context.scene
 
 
-def configure_render(scene, width, height, threads=0):
+def configure_render(scene, width, height, threads=0, clamp_indirect=CLAMP_INDIRECT):
     """Everything that does not change between the renders of one scene."""
     r = scene.render
     r.engine = "CYCLES"
@@ -142,7 +147,7 @@ def configure_render(scene, width, height, threads=0):
     c.sample_offset = 0
     c.time_limit = 0.0
     c.sample_clamp_direct = 0.0
-    c.sample_clamp_indirect = CLAMP_INDIRECT
+    c.sample_clamp_indirect = clamp_indirect
     c.max_bounces = MAX_BOUNCES
     c.diffuse_bounces = 4
     c.glossy_bounces = 4
@@ -443,13 +448,50 @@ def area_light(name, location, size, power, color=(1.0, 1.0, 1.0), rotation=(0.0
     return obj
 
 
-def camera(name, location, look_at, lens=35.0, sensor=36.0):
+def sun_light(name, rotation, strength, angle_deg=0.5, color=(1.0, 1.0, 1.0)):
+    """Sun lamp; it shines along its local -Z, so `rotation` (Euler XYZ) aims it."""
+    data = bpy.data.lights.new(name, "SUN")
+    data.energy = strength  # irradiance, W/m^2
+    data.angle = math.radians(angle_deg)
+    data.color = color
+    obj = bpy.data.objects.new(name, data)
+    obj.rotation_euler = rotation
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
+def sky_world(scene, sun_elevation_deg, sun_rotation_deg, strength=1.0, sky_type="NISHITA"):
+    """Procedural sky (no image) as world light; its own sun disc is off (a Sun lamp does that)."""
+    world = scene.world
+    world.use_nodes = True
+    nt = world.node_tree
+    bg = nt.nodes.get("Background")
+    sky = nt.nodes.new("ShaderNodeTexSky")
+    sky.sky_type = sky_type
+    if sky_type == "NISHITA":
+        sky.sun_disc = False
+        sky.sun_elevation = math.radians(sun_elevation_deg)
+        sky.sun_rotation = math.radians(sun_rotation_deg)
+    else:
+        el, rot = math.radians(sun_elevation_deg), math.radians(sun_rotation_deg)
+        sky.sun_direction = (math.cos(el) * math.sin(rot), -math.cos(el) * math.cos(rot),
+                             math.sin(el))
+    nt.links.new(sky.outputs["Color"], bg.inputs["Color"])
+    bg.inputs["Strength"].default_value = strength
+    return world
+
+
+def camera(name, location, look_at, lens=35.0, sensor=36.0, ortho_scale=None):
+    """Perspective camera, or orthographic `ortho_scale` metres wide when that is given."""
     data = bpy.data.cameras.new(name)
     data.lens = lens
     data.sensor_width = sensor
     data.sensor_fit = "HORIZONTAL"
     data.clip_start = 0.05
     data.clip_end = 100.0
+    if ortho_scale is not None:
+        data.type = "ORTHO"
+        data.ortho_scale = ortho_scale
     obj = bpy.data.objects.new(name, data)
     bpy.context.scene.collection.objects.link(obj)
     obj.location = location
@@ -480,6 +522,9 @@ def camera_info(scene):
         "clip_end": round(d.clip_end, 6),
         "dof": bool(d.dof.use_dof),
     }
+    if d.type == "ORTHO":
+        info["type"] = "ORTHO"
+        info["ortho_scale"] = round(d.ortho_scale, 6)
     if d.dof.use_dof:
         info["fstop"] = round(d.dof.aperture_fstop, 6)
         info["focus_distance"] = round(d.dof.focus_distance, 6)
@@ -491,9 +536,10 @@ def _emit(record):
     print("MCRECON_FILE " + json.dumps(record), flush=True)
 
 
-def _render_one(scene, view_layer, path, spp, seed, all_passes):
+def _render_one(scene, view_layer, path, spp, seed, all_passes, sample_offset=0):
     scene.cycles.samples = spp
     scene.cycles.seed = seed
+    scene.cycles.sample_offset = sample_offset
     set_passes(view_layer, all_passes)
     scene.render.filepath = path
     t0 = time.perf_counter()
@@ -504,10 +550,14 @@ def _render_one(scene, view_layer, path, spp, seed, all_passes):
     return dt
 
 
-def render_jobs(args, scene_name):
-    """Render the noisy levels and the reference of a still, or of every frame of a sequence."""
+def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT):
+    """Render the noisy levels and the reference of a still, or of every frame of a sequence.
+
+    A still's level listed in args.halves is also written as two half buffers: spp/2 samples
+    each with the level's own seed and sample offsets 0 and spp/2, so that their mean is the
+    level's file (the same samples, split in two)."""
     scene = bpy.context.scene
-    view_layer = configure_render(scene, args.width, args.height, args.threads)
+    view_layer = configure_render(scene, args.width, args.height, args.threads, clamp_indirect)
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     if args.save_blend:
@@ -527,7 +577,9 @@ def render_jobs(args, scene_name):
             dt = _render_one(scene, view_layer, os.path.join(out, name), spp, seed, all_passes)
             _emit({"scene": scene_name, "file": name, "kind": kind, "spp": spp, "seed": seed,
                    "frame": None, "seconds": round(dt, 3), "all_passes": all_passes})
-        _emit_info(info)
+            if kind == "noisy" and spp in args.halves:
+                _render_halves(scene, view_layer, out, scene_name, spp, seed)
+        _emit_info(info, clamp_indirect)
         return
 
     f0, f1 = args.frames
@@ -546,13 +598,27 @@ def render_jobs(args, scene_name):
                    "frame": frame, "seconds": round(dt, 3), "all_passes": all_passes})
     _emit_info({"scene": scene_name, "width": args.width, "height": args.height,
                 "frames": [f0, f1], "fps": scene.render.fps,
-                "camera": {str(k): v for k, v in cams.items()}})
+                "camera": {str(k): v for k, v in cams.items()}}, clamp_indirect)
 
 
-def _emit_info(info):
+def _render_halves(scene, view_layer, out, scene_name, spp, seed):
+    if spp % 2:
+        raise ValueError(f"--halves: {spp} spp cannot be split in two equal halves")
+    half = spp // 2
+    for i in (0, 1):
+        name = f"{scene_name}_{spp}spp_half{i}.exr"
+        dt = _render_one(scene, view_layer, os.path.join(out, name), half, seed, True,
+                         sample_offset=i * half)
+        _emit({"scene": scene_name, "file": name, "kind": "half", "spp": half, "of_spp": spp,
+               "half": i, "sample_offset": i * half, "seed": seed, "frame": None,
+               "seconds": round(dt, 3), "all_passes": True})
+    scene.cycles.sample_offset = 0
+
+
+def _emit_info(info, clamp_indirect):
     info["blender_version"] = bpy.app.version_string
     info["cycles"] = {"device": "CPU", "denoising": False, "adaptive_sampling": False,
-                      "clamp_indirect": CLAMP_INDIRECT, "max_bounces": MAX_BOUNCES,
+                      "clamp_indirect": clamp_indirect, "max_bounces": MAX_BOUNCES,
                       "pixel_filter": "BLACKMAN_HARRIS 1.5 px",
                       "sampling_pattern": bpy.context.scene.cycles.sampling_pattern}
     print("MCRECON_INFO " + json.dumps(info), flush=True)
