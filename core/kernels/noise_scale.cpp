@@ -33,7 +33,19 @@ float median_of(float* v, int n) {
   return 0.5f * (*std::max_element(v, v + n / 2) + hi);
 }
 
+double luminance2(const float* m) { return (double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0; }
+
 }  // namespace
+
+double NoiseScales::robust(std::size_t i, int c) const {
+  const double m = median[i * 3 + std::size_t(c)];
+  return std::min(std::max(double(relative[i]) * (m * m + kRelativeEps), kFloorRelative * kFloorRelative * m * m), 3.0e38);
+}
+
+double NoiseScales::variance_of(std::size_t i, int c) const {
+  const double m = median[i * 3 + std::size_t(c)];
+  return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(&median[i * 3]) + kRelativeEps);
+}
 
 NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads) {
   const int W = colour.width(), H = colour.height();
@@ -43,7 +55,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   const Rgb y{colour};
   const std::size_t n = std::size_t(s.box.width()) * std::size_t(s.box.height());
   s.variance.assign(n, 0.0f);
-  s.robust.assign(n, 0.0f);
+  s.relative.assign(n, 0.0f);
   s.median.assign(n * 3, 0.0f);
   s.finite.assign(n, 0);
   s.outlier.assign(n, 0);
@@ -144,7 +156,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       if (!y.finite(x, yy)) continue;
       s.finite[o] = 1;
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
-      double my2 = 0, dev = 0;
+      double dev = 0;
       const float* p = y.at(x, yy);
       float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
       bool any = false;
@@ -159,19 +171,13 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
           }
           any = true;
         }
+      for (int c = 0; c < 3; ++c) s.median[o * 3 + std::size_t(c)] = med[i * 3 + std::size_t(c)];
+      s.relative[o] = tile_rel[std::size_t((yy - s.box.y0) / kTile) * std::size_t(ntx) + std::size_t((x - s.box.x0) / kTile)];
       for (int c = 0; c < 3; ++c) {
-        const float m = med[i * 3 + std::size_t(c)];
-        s.median[o * 3 + std::size_t(c)] = m;
-        my2 += double(m) * m;
         const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
-        dev += out * out;
+        dev += out * out / std::max(s.robust(o, c), 1e-30);
       }
-      my2 /= 3.0;
-      dev /= 3.0;
-      const double rel = tile_rel[std::size_t((yy - s.box.y0) / kTile) * std::size_t(ntx) + std::size_t((x - s.box.x0) / kTile)];
-      const double robust = std::max(rel * (my2 + kRelativeEps), kFloorRelative * kFloorRelative * my2);
-      s.robust[o] = float(std::min(robust, 3.0e38));
-      s.outlier[o] = dev > kOutlierSigmas * kOutlierSigmas * robust ? 1 : 0;
+      s.outlier[o] = dev / 3.0 > kOutlierSigmas * kOutlierSigmas ? 1 : 0;
       s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0), 0.0), 3.0e38));
     }
   });

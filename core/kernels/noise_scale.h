@@ -10,12 +10,15 @@
 //                edges cancel and smooth shading or a pixel filter's blur make it err low.
 //                A one-pixel peak counts as noise.
 //   median(p)    per-channel median of the finite pixels of the 3x3 neighbourhood.
-//   robust(p)    a scale sparse bright structure cannot inflate: the median, over a tile
-//                (4x4 pixels grown by 4), of the 8-neighbour high-pass residual energy
-//                relative to (median luminance^2 + 1e-3), times this pixel's
-//                (median luminance^2 + 1e-3), times 1.27 (median -> mean of a chi^2_3/3);
-//                at least (0.02 * median)^2: 2% is below what anyone sees, and a converged
-//                render then still has a scale.
+//   relative(p)  a relative noise level sparse bright structure cannot inflate: the
+//                median, over a tile (4x4 pixels grown by 4), of the 8-neighbour high-pass
+//                residual energy divided by (median luminance^2 + 1e-3), times 1.27
+//                (median -> mean of a chi^2_3/3).
+//   robust(p,c)  channel c's noise variance from it: relative(p) (median_c(p)^2 + 1e-3),
+//                at least (0.02 median_c(p))^2 (2% is below what anyone sees, and a
+//                converged render still has a scale). Monte Carlo noise grows with the
+//                value, so a dark channel next to a bright one keeps a small scale.
+//   variance(p,c) variance(p) shared among the channels in the same proportion.
 //   outlier(p)   y(p) lies beyond the range of its 8 finite neighbours by more than 4
 //                robust deviations (mean over R, G, B of the squared excess > 16 robust(p)):
 //                a firefly (or a one-pixel highlight); a block's corner is not one.
@@ -31,14 +34,17 @@ namespace mcr {
 
 struct NoiseScales {
   Roi box;                          // where the vectors below hold values, row-major
-  std::vector<float> variance;      // one per pixel
-  std::vector<float> robust;        // one per pixel
+  std::vector<float> variance;      // one per pixel (mean over R, G, B)
+  std::vector<float> relative;      // one per pixel
   std::vector<float> median;        // three per pixel (RGB)
   std::vector<std::uint8_t> finite; // the pixel's RGB is finite
   std::vector<std::uint8_t> outlier;
   std::size_t at(int x, int y) const {
     return std::size_t(y - box.y0) * std::size_t(box.width()) + std::size_t(x - box.x0);
   }
+  double robust(std::size_t i, int c) const;
+  double robust(std::size_t i) const { return (robust(i, 0) + robust(i, 1) + robust(i, 2)) / 3.0; }
+  double variance_of(std::size_t i, int c) const;
 };
 
 constexpr double kOutlierSigmas = 4.0;  // outlier: further than this many robust deviations

@@ -36,16 +36,17 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
       const std::size_t i = ns.at(x, y);
       if (!ns.finite[i] || ns.outlier[i]) continue;
       const float* m = &ns.median[i * 3];
-      const double w = 1.0 / ((double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0 + kRelMseEps);
       const float* p = input.pixel(x, y);
       const float* f = out.pixel(x, y);
-      double d2 = 0;
+      double nv = 0, dv = 0;
       for (int c = 0; c < 3; ++c) {
+        const double w = 1.0 / (double(m[c]) * m[c] + kRelMseEps);
         const double d = double(f[c]) - double(p[c]);
-        d2 += d * d;
+        nv += w * ns.variance_of(i, c);
+        dv += w * d * d;
       }
-      num.set(x - roi.x0, y - roi.y0, w * ns.variance[i], 0.0);
-      den.set(x - roi.x0, y - roi.y0, std::min(w * d2 / 3.0, 1e300), 0.0);
+      num.set(x - roi.x0, y - roi.y0, nv, 0.0);
+      den.set(x - roi.x0, y - roi.y0, std::min(dv, 1e300), 0.0);
     }
   });
   num.sum_windows(radius, nthreads);
@@ -69,14 +70,11 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
       const float* m = &ns.median[i * 3];
       const double n = num.value(x - roi.x0, y - roi.y0), d = den.value(x - roi.x0, y - roi.y0);
       double a = d > 0 ? std::min(n / d, 1.0) : 1.0;
-      double dm = 0;
       for (int c = 0; c < 3; ++c) {
         const double e = double(f[c]) - double(m[c]);
-        dm += e * e;
+        const double limit = kOutlierSigmas * kOutlierSigmas * ns.robust(i, c);
+        if (e * e > limit) a = std::min(a, limit / (e * e));
       }
-      dm /= 3.0;
-      const double limit = kOutlierSigmas * kOutlierSigmas * double(ns.robust[i]);
-      if (dm > limit) a = std::min(a, limit / dm);
       // The 3x3 input range (fireflies as their median), widened by kRangeSigmas.
       double lo[3], hi[3];
       for (int c = 0; c < 3; ++c) lo[c] = hi[c] = p[c];
@@ -92,8 +90,8 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
             hi[c] = std::max(hi[c], double(q[c]));
           }
         }
-      const double widen = kRangeSigmas * std::sqrt(double(ns.robust[i]));
       for (int c = 0; c < 3; ++c) {
+        const double widen = kRangeSigmas * std::sqrt(ns.robust(i, c));
         const double v = double(p[c]) + a * (double(f[c]) - double(p[c]));
         f[c] = float(clamp_float(std::min(std::max(v, lo[c] - widen), hi[c] + widen)));
       }

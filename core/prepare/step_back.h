@@ -6,12 +6,13 @@
 // For a result f of the noisy input y = x + n (noise variance s^2 per pixel), the blend
 // y + a (f - y) has expected squared error a^2 E|f-y|^2 - 2 a s^2 (1 - div f) + s^2
 // (Stein's lemma), smallest at a = s^2 (1 - div f) / E|f-y|^2. With div f ~ 0 (a filter
-// that averages many pixels) a = s^2 / |f-y|^2, taken over a (2 radius + 1)^2 window,
-// each pixel weighted by 1 / (median luminance^2 + 0.01) as relMSE weighs it, and
+// that averages many pixels) a = s^2 / |f-y|^2, summed over a (2 radius + 1)^2 window and
+// R, G, B, each channel weighted by 1 / (median_c^2 + 0.01) as relMSE weighs it, and
 // clamped to [0, 1]. Then, per pixel (kernels/noise_scale.h for the scales):
 //   - a firefly (outlier) takes the filter's value: removing it is the point;
-//   - elsewhere a <= 16 robust / |f - median|^2: the result may not leave the 3x3 median
-//     by more than 4 robust deviations (it would have pulled light from a neighbour);
+//   - elsewhere a <= 16 robust_c / (f_c - median_c)^2 for every channel: the result may
+//     not leave the 3x3 median by more than 4 robust deviations (it would have pulled
+//     light from a neighbour);
 //   - the blend is clamped to the 3x3 range of the input (fireflies read as their
 //     median) widened by 2 robust deviations.
 // With s^2 estimated within 2x of the truth the blend is never worse than the input in
