@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cfloat>
 #include <cmath>
+#include <utility>
 
+#include "kernels/feature_activity.h"
 #include "kernels/planes.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -106,6 +108,8 @@ void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& 
   g.colour = false;
   g.colour_a.clear();
   g.used.clear();
+  g.skipped.clear();
+  std::vector<std::pair<const Image*, int>> mask_only;  // dropped as constant, but with non-finite pixels
   std::size_t used_guides = 0;  // g.list entries keep their memory for the next frame
   const Roi& box = pb.box;
 
@@ -150,6 +154,21 @@ void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& 
       note(name + " weight dropped: no " + name + " pass in '" + frame.path + "' (use_" + name + "=auto)");
       continue;
     }
+    {
+      // A pass constant within constant_tolerance(the smallest sigma) over the box: its
+      // weight is 1 within 1e-4 for every pair, so it is dropped. Its non-finite pixels
+      // stay unusable neighbours (mask_only), as with the weight on.
+      const FoveatedValue sg = fov.param(name + "_sigma");
+      const double sigma = sg.varies ? std::min(sg.inner, sg.outer) : sg.inner;
+      const int nch = f == Feature::Depth ? 1 : 3;
+      const FeatureActivity act = feature_activity(pass->image, nch, box, constant_tolerance(sigma), nthreads);
+      if (act.kind != Activity::Varies) {
+        note(activity_note(name, act, box, frame.width, frame.height, name + " weight not used"));
+        g.skipped.push_back(name);
+        if (act.kind == Activity::Constant && act.some_nonfinite) mask_only.emplace_back(&pass->image, nch);
+        continue;
+      }
+    }
     if (g.list.size() <= used_guides) g.list.emplace_back();
     Guides::Guide& gd = g.list[used_guides++];
     gd.feature = f;
@@ -193,6 +212,16 @@ void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& 
   g.list.resize(used_guides);
 
   pb.prepare(g.ok, 1.0f);
+  for (const auto& [im, nch] : mask_only)
+    parallel_rows(box.y0, box.y1, nthreads, [&, im = im, nch = nch](int y) {
+      const int ch = im->channels();
+      for (int x = box.x0; x < box.x1; ++x) {
+        const float* v = im->pixel(x, y);
+        bool finite = true;
+        for (int c = 0; c < nch; ++c) finite = finite && std::isfinite(v[std::min(c, ch - 1)]);
+        if (!finite) g.ok[pb.index(x, y)] = 0.0f;
+      }
+    });
   for (const Guides::Guide& gd : g.list)
     if (!gd.k.empty())  // k >= 5e-13 for any sigma in range: 0 marks exactly the non-finite values
       parallel_rows(box.y0, box.y1, nthreads, [&](int y) {

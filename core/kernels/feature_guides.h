@@ -66,9 +66,13 @@ struct Guides {
   std::vector<Guide> list;        // enabled non-colour features present in the frame, Feature order
   std::vector<float> ok;          // 1 where every guide in list is finite, else 0
   std::vector<std::string> used;  // names of the features in use, colour first
+  std::vector<std::string> skipped;  // present but constant or all non-finite (feature_activity.h): not used
 };
 // Reads use_<f>/<f>_sigma (and the _outer twins when foveated). Features set to
 // "auto" whose pass is absent are dropped through note(); "on" ones throw MissingPass.
+// A present pass (auto or on) that is constant over pb.box within
+// constant_tolerance(sigma) (kernels/feature_activity.h: every weight within 1e-4 of 1)
+// or has no finite value there is dropped too, with a note, and listed in `skipped`.
 // Fills `g`, reusing the memory it holds from an earlier call.
 void gather_guides(const Frame& frame, const ParamSet& params, const Foveation& fov, const std::string& filter,
                    const PlaneBox& pb, const std::function<void(std::string)>& note, int nthreads, Guides& g);

@@ -559,9 +559,15 @@ TEST(GuidedFilterTest, EverythingInvalid) {
   for (float v : res.out.storage()) EXPECT_EQ(v, 0.0f);
   Passes nan_guide = ps;
   for (float& v : nan_guide.normal.storage()) v = kNaN;
+  for (float& v : nan_guide.depth.storage()) v = kNaN;
   res = run_guided(frame_of(nan_guide), {{"radius", std::int64_t(2)}});
   EXPECT_EQ(res.repaired, 0u);
   EXPECT_EQ(res.out.storage(), ps.colour.storage());
+  // An all-NaN normal alone is an absent pass: the guide is the depth (constant_feature_skip_test).
+  nan_guide.depth = ps.depth;
+  res = run_guided(frame_of(nan_guide), {{"radius", std::int64_t(2)}});
+  expect_close(res.out, run_guided(frame_of(nan_guide), {{"radius", std::int64_t(2)}, {"guide", std::string("depth")}}).out,
+               1e-6, "NaN normal");
 }
 
 TEST(GuidedFilterTest, AllEqualFeaturesAndEpsilonAtItsLimits) {

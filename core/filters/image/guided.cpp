@@ -245,7 +245,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   std::vector<std::pair<int, int>> groups;  // first channel, count
   std::vector<bool> unit;
   int d = 0;
-  for (const GroupSpec& g : choice.groups) {
+  for (const GroupSpec& g : active_groups(choice, frame, c.eps, nthreads, [this](std::string s) { note(std::move(s)); })) {
     const Image* img = nullptr;
     if (g.source == Source::Colour) {
       img = colour;

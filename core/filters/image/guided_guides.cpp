@@ -1,5 +1,8 @@
 #include "filters/image/guided_guides.h"
 
+#include <cmath>
+
+#include "kernels/feature_activity.h"
 #include "util/error.h"
 
 namespace mcr::guided {
@@ -54,5 +57,40 @@ Role source_role(Source s) {
 }
 
 bool reads_pass(Source s) { return s != Source::Luminance && s != Source::Colour; }
+
+std::vector<GroupSpec> active_groups(const GuideChoice& choice, const Frame& frame, double epsilon, int nthreads,
+                                     const std::function<void(std::string)>& note) {
+  std::vector<GroupSpec> kept;
+  std::vector<std::string> dropped;
+  const GroupSpec* smallest = nullptr;
+  const Roi all = Roi::all(frame.width, frame.height);
+  for (const GroupSpec& g : choice.groups) {
+    if (!smallest || g.channels < smallest->channels) smallest = &g;
+    if (!reads_pass(g.source)) {
+      kept.push_back(g);
+      continue;
+    }
+    const Pass* pass = frame.find(source_role(g.source));
+    if (!pass) {  // needs() has checked: not reached
+      kept.push_back(g);
+      continue;
+    }
+    const Tolerance tol = g.unit ? Tolerance(constant_tolerance(std::sqrt(epsilon))) : Tolerance(0.0, 0.49e-5);
+    const FeatureActivity a = feature_activity(pass->image, g.channels, all, tol, nthreads);
+    if (a.kind == Activity::Varies) {
+      kept.push_back(g);
+      continue;
+    }
+    dropped.push_back(activity_note(role_name(pass->role), a, all, frame.width, frame.height, "left out of the guide"));
+  }
+  if (kept.empty()) {
+    kept.push_back(*smallest);
+    note("guided: no guide pass varies over the frame; the " + std::string(role_name(source_role(smallest->source))) +
+         " pass stays as the guide (the result is the box-of-box mean of the colour)");
+    return kept;
+  }
+  for (std::string& d : dropped) note("guided: " + d);
+  return kept;
+}
 
 }  // namespace mcr::guided

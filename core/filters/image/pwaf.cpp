@@ -11,6 +11,7 @@
 
 #include "image/luminance.h"
 #include "kernels/fast_exp.h"
+#include "kernels/feature_activity.h"
 #include "kernels/noise_variance.h"
 #include "prepare/outliers.h"
 #include "util/error.h"
@@ -334,9 +335,27 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   if (!pos2 && pos1) note("pwaf: no second_position pass; Gsp uses the first-hit position pass instead");
   if (!pos2 && !pos1) note("pwaf: no second_position or position pass; Gsp dropped");
   if (!nrm2) note("pwaf: no second_normal pass; Gsn dropped (the first-hit normal is already in Gn)");
-  const Feature fn = make_feature(normal, params_.get_float("sigma_n"), false);
-  const Feature fsp = make_feature(pos2 ? pos2 : pos1, params_.get_float("sigma_sp"), true);
-  const Feature fsn = make_feature(nrm2, params_.get_float("sigma_sn"), false);
+  const Roi fr = roi.grown(max_r, w, h);  // what the feature weights read
+  // A pass constant over fr within constant_tolerance(its sigma) gives every pair a
+  // factor within 1e-4 of 1 (kernels/feature_activity.h); one with no finite value
+  // gives every pair factor 1: either is dropped. An exactly constant position is
+  // dropped before its spacing scale is measured (a frame-wide sort).
+  auto active = [&](const Pass* pass, double sigma, bool scale_by_spacing, const char* what, const char* weight) {
+    if (!pass) return Feature{};
+    FeatureActivity a = feature_activity(pass->image, 3, fr, 0.0, nthreads);
+    Feature f;
+    if (a.kind == Activity::Varies) {
+      f = make_feature(pass, sigma, scale_by_spacing);
+      a = feature_activity(pass->image, 3, fr, constant_tolerance(std::sqrt(0.5 / f.inv2s2)), nthreads);
+      if (a.kind == Activity::Varies) return f;
+    }
+    note("pwaf: " + activity_note(what, a, fr, w, h, std::string(weight) + " not used"));
+    return Feature{};
+  };
+  const Feature fn = active(normal, params_.get_float("sigma_n"), false, "normal", "Gn");
+  const Feature fsp =
+      active(pos2 ? pos2 : pos1, params_.get_float("sigma_sp"), true, pos2 ? "second_position" : "position", "Gsp");
+  const Feature fsn = active(nrm2, params_.get_float("sigma_sn"), false, "second_normal", "Gsn");
   const Feature* used[3];
   double inv[3] = {0, 0, 0};
   int nf = 0;
@@ -349,7 +368,6 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // then the used features (3 floats each, non-finite ones zeroed); mask bit 0 = valid colour,
   // bit k+1 = feature k finite.
   const int stride = 3 + 3 * nf;
-  const Roi fr = roi.grown(max_r, w, h);
   const int fw = fr.width();
   std::vector<float> pk(std::size_t(fw) * fr.height() * stride, 0.0f);
   std::vector<std::uint8_t> mask(std::size_t(fw) * fr.height(), 0);

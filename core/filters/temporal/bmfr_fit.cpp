@@ -204,12 +204,19 @@ MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
   };
   std::fill(feat, feat + np, 1.0f);
   // Columns: 0 constant; 1..3 normal; 4..6 position; [7..9 position^2]; extras.
+  // Columns of frame-wide constant passes (lay.dropped) are 0 here and left out of the QR.
+  auto dropped = [&](int col) { return (lay.dropped >> col) & 1u; };
   for (int c = 0; c < R; ++c) {
-    const int col = c < 6 ? 1 + c : 1 + c + (lay.squares ? 3 : 0);
-    scale_column(raw + std::size_t(c) * snp, feat + std::size_t(col) * snp);
+    const int col = lay.column_of_raw(c);
+    if (dropped(col)) std::fill(feat + std::size_t(col) * snp, feat + std::size_t(col + 1) * snp, 0.0f);
+    else scale_column(raw + std::size_t(c) * snp, feat + std::size_t(col) * snp);
   }
   if (lay.squares)
     for (int c = 0; c < 3; ++c) {
+      if (dropped(7 + c)) {
+        std::fill(feat + std::size_t(7 + c) * snp, feat + std::size_t(8 + c) * snp, 0.0f);
+        continue;
+      }
       // Square of the scaled position: the same span as w^2 with w, better conditioned.
       float* sq = raw;  // raw column 0 is no longer needed: reuse as scratch
       const float* s0 = feat + std::size_t(4 + c) * snp;
@@ -252,8 +259,15 @@ MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
   typedef std::int32_t noise_word __attribute__((__may_alias__));
   static_assert(__BYTE_ORDER__ == __ORDER_LITTLE_ENDIAN__, "noise words assume little endian");
   const int even = W & ~1;
-  for (int m = 1; m < M; ++m) {
-    double* col = mat + std::size_t(m) * sW;
+  // The fitted columns: all but the dropped ones, each with the noise of its own index.
+  int fcol[32];
+  int MK = 1;
+  fcol[0] = 0;
+  for (int m = 1; m < M; ++m)
+    if (!dropped(m)) fcol[MK++] = m;
+  for (int k = 1; k < MK; ++k) {
+    const int m = fcol[k];
+    double* col = mat + std::size_t(k) * sW;
     const float* fm = feat + std::size_t(m) * snp;
     const noise_word* q = nz ? reinterpret_cast<const noise_word*>(nz + std::size_t(m - 1) * hs) : nullptr;
     if (dense && q)
@@ -273,7 +287,7 @@ MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
   }
   double zmin[3], zmax[3];
   for (int c = 0; c < 3; ++c) {
-    double* col = mat + std::size_t(M + c) * sW;
+    double* col = mat + std::size_t(MK + c) * sW;
     const float* zc = zp + std::size_t(c) * snp;
     float zm = INFINITY, zx = -INFINITY;
     if (dense) {
@@ -311,9 +325,13 @@ MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
     zmin[c] = double(zm);
     zmax[c] = double(zx);
   }
-  S.qr.factorize(mat, W, M, 3);
-  double alpha[3][32];
-  for (int c = 0; c < 3; ++c) S.qr.solve(c, alpha[c]);
+  S.qr.factorize(mat, W, MK, 3);
+  double alpha[3][32], ak[32];
+  for (int c = 0; c < 3; ++c) {
+    S.qr.solve(c, ak);
+    std::fill(alpha[c], alpha[c] + M, 0.0);
+    for (int k = 0; k < MK; ++k) alpha[c][fcol[k]] = ak[k];
+  }
   // Synthesis with the noise-free features, the three channels in one sweep over each
   // 4-pixel chunk (sums in registers; per channel the same terms in the same order as
   // a channel-by-channel loop, a zero coefficient skipped).
@@ -389,7 +407,7 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
                             int nthreads) {
   const int w = frame.width, h = frame.height;
   const int B = block_side(params_.get_int("block_size"), w, h);
-  const FeatureLayout lay = layout_of(params_.get_enum("features"));
+  FeatureLayout lay = layout_of(params_.get_enum("features"));
   const double eps = params_.get_float("epsilon");
   const std::uint64_t seed = std::uint64_t(params_.get_int("seed"));
   const bool clamp_max = params_.get_bool("fit_clamp");
@@ -397,6 +415,9 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   const Image& nrm = frame.image(Role::Normal, Prefer::Geometry);
   const Image* alb = lay.albedo ? &frame.image(Role::Albedo) : nullptr;
   const Image* dep = lay.depth ? &frame.image(Role::Depth) : nullptr;
+  std::vector<std::string> skipped;
+  lay.dropped = constant_columns(lay, nrm, pos, alb, dep, nthreads, skipped);
+  for (std::string& s : skipped) note("bmfr: " + s);
 
   int ox = 0, oy = 0;
   if (params_.get_bool("offsets")) {

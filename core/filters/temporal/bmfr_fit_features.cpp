@@ -6,6 +6,7 @@
 #if defined(__SSE2__)
 #include <emmintrin.h>
 #endif
+#include "kernels/feature_activity.h"
 #include "util/avx2_shuffles.h"
 
 namespace mcr::bmfr {
@@ -16,6 +17,28 @@ FeatureLayout layout_of(const std::string& set) {
   if (set == "with_albedo") l.albedo = true;
   if (set == "with_depth") l.depth = true;
   return l;
+}
+
+unsigned constant_columns(const FeatureLayout& lay, const Image& nrm, const Image& pos, const Image* alb,
+                          const Image* dep, int nthreads, std::vector<std::string>& notes) {
+  struct Src {
+    const Image* im;
+    const char* name;
+    int raw0, channels;
+  };
+  const Src srcs[4] = {{&nrm, "normal", 0, 3}, {&pos, "position", 3, 3}, {alb, "albedo", 6, 3},
+                       {dep, "depth", lay.albedo ? 9 : 6, 1}};
+  unsigned drop = 0;
+  for (const Src& s : srcs) {
+    if (!s.im) continue;
+    const Roi all = Roi::all(s.im->width(), s.im->height());
+    const FeatureActivity a = feature_activity(*s.im, s.channels, all, Tolerance(0.0, 0.49e-5), nthreads);
+    if (a.kind != Activity::Constant) continue;
+    for (int c = 0; c < s.channels; ++c) drop |= 1u << lay.column_of_raw(s.raw0 + c);
+    if (s.raw0 == 3 && lay.squares) drop |= 7u << 7;  // the squares of a constant position
+    notes.push_back(activity_note(s.name, a, all, all.width(), all.height(), "left out of the regression"));
+  }
+  return drop;
 }
 
 void masked_min_max(const float* src, const float* mask, int np, float& lo, float& hi) {

@@ -4,6 +4,9 @@
 // over its finite pixels, and the AVX2 gather of the default set's block rows.
 #include <cstddef>
 #include <string>
+#include <vector>
+
+#include "image/image.h"
 
 namespace mcr::bmfr {
 
@@ -13,9 +16,25 @@ struct FeatureLayout {
   bool squares = true;        // w^2 columns
   bool albedo = false;        // + albedo RGB
   bool depth = false;         // + depth
+  unsigned dropped = 0;       // bit m: fitted column m left out (constant_columns)
   int raw() const { return 6 + (albedo ? 3 : 0) + (depth ? 1 : 0); }
   int columns() const { return 1 + raw() + (squares ? 3 : 0); }
+  // The matrix column of raw channel c.
+  int column_of_raw(int c) const { return c < 6 ? 1 + c : 1 + c + (squares ? 3 : 0); }
 };
+
+// The fitted columns of passes constant over the whole frame, as FeatureLayout::dropped
+// bits, with a note per pass in `notes`. A pass whose finite pixels all lie within
+// 0.49e-5 |v| of the first one, channel by channel (kernels/feature_activity.h), has in
+// every block a range under 1e-5 of its magnitude, which the fit's column scaling
+// turns into a zero column, one the QR then drops (coefficient 0): leaving those
+// columns out of every block's matrix gives the same fit (exactly with epsilon = 0;
+// with epsilon > 0 the other columns keep their noise, only the noise the zero
+// columns would carry is gone), with a smaller QR. A constant position drops its
+// squares too. Passes with no finite value are not dropped: their pixels are left
+// out of the fit anyway.
+unsigned constant_columns(const FeatureLayout& lay, const Image& nrm, const Image& pos, const Image* alb,
+                          const Image* dep, int nthreads, std::vector<std::string>& notes);
 
 FeatureLayout layout_of(const std::string& set);  // the `features` parameter's value
 
