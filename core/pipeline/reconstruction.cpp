@@ -1,13 +1,13 @@
 #include "pipeline/reconstruction.h"
 
-#include "filters/registry.h"
+#include "pipeline/filter_catalog.h"
 #include "util/error.h"
 
 namespace mcr {
 
 std::unique_ptr<Filter> make_committed_filter(const std::string& filter,
                                               const std::vector<std::pair<std::string, std::string>>& params) {
-  std::unique_ptr<Filter> f = make_filter(filter);
+  std::unique_ptr<Filter> f = make_catalog_filter(filter);
   for (const auto& kv : params) f->set_text(kv.first, kv.second);
   f->commit();
   return f;

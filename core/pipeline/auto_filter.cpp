@@ -1,0 +1,285 @@
+#include "pipeline/auto_filter.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+
+#include "filters/registry.h"
+#include "kernels/noise_scale.h"
+
+namespace mcr {
+
+namespace {
+
+constexpr int kTile = 32;          // scored tile side
+constexpr int kMargin = 32;        // what a candidate sees around a tile
+constexpr double kRelMseEps = 0.01;
+constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
+
+std::string fixed(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
+// The frame's passes inside r (a new, smaller frame).
+Frame crop(const Frame& f, const Roi& r) {
+  Frame c;
+  c.width = r.width();
+  c.height = r.height();
+  c.path = f.path;
+  c.layer = f.layer;
+  c.frame_number = f.frame_number;
+  for (const Pass& p : f.passes) {
+    Pass q = p;
+    const int ch = p.image.channels();
+    q.image = Image(c.width, c.height, ch);
+    for (int y = 0; y < c.height; ++y) {
+      const float* s = p.image.pixel(r.x0, r.y0 + y);
+      std::copy(s, s + std::size_t(c.width) * std::size_t(ch), q.image.pixel(0, y));
+    }
+    c.passes.push_back(std::move(q));
+  }
+  return c;
+}
+
+// Tiles of about kTile px covering about `fraction` of roi, on a regular grid; the whole
+// roi as one tile when it is small.
+std::vector<Roi> sample_tiles(const Roi& roi, double fraction) {
+  const double area = double(roi.width()) * roi.height();
+  const double want = std::max(1.0, std::round(fraction * area / (kTile * kTile)));
+  if (roi.width() < 3 * kTile || roi.height() < 3 * kTile || want * kTile * kTile >= 0.5 * area) return {roi};
+  const int nx = std::max(1, int(std::round(std::sqrt(want * roi.width() / roi.height()))));
+  const int ny = std::max(1, int(std::round(want / nx)));
+  std::vector<Roi> tiles;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const int cx = roi.x0 + int((i + 0.5) * roi.width() / nx), cy = roi.y0 + int((j + 0.5) * roi.height() / ny);
+      const int x0 = std::min(std::max(cx - kTile / 2, roi.x0), roi.x1 - kTile);
+      const int y0 = std::min(std::max(cy - kTile / 2, roi.y0), roi.y1 - kTile);
+      tiles.push_back({x0, y0, x0 + kTile, y0 + kTile});
+    }
+  return tiles;
+}
+
+// One tile: the cropped frame, its copy with the probe added inside the tile, the noise.
+struct Sample {
+  Frame frame, probed;
+  Roi inner;  // the tile, in the crop's coordinates
+  NoiseScales noise;
+  std::vector<float> sign_over_eps;  // b_c / eps_c per pixel of the tile and channel
+  std::vector<float> weight;         // relMSE weight 1 / (local mean_c^2 + 0.01) per pixel and channel
+};
+
+// relMSE weighs by the reference; the 7x7 mean of the input (fireflies read as their
+// median) stands in for it, smooth enough that noise spread by the variance estimate
+// and the error a filter spreads are weighed alike.
+std::vector<float> local_weights(const Image& y, const NoiseScales& ns, const Roi& inner) {
+  std::vector<float> w(std::size_t(inner.width()) * inner.height() * 3, 0.0f);
+  std::size_t k = 0;
+  for (int yy = inner.y0; yy < inner.y1; ++yy)
+    for (int x = inner.x0; x < inner.x1; ++x) {
+      double sum[3] = {0, 0, 0};
+      int n = 0;
+      for (int qy = std::max(inner.y0, yy - 3); qy <= std::min(inner.y1 - 1, yy + 3); ++qy)
+        for (int qx = std::max(inner.x0, x - 3); qx <= std::min(inner.x1 - 1, x + 3); ++qx) {
+          const std::size_t j = ns.at(qx, qy);
+          if (!ns.finite[j]) continue;
+          const float* q = ns.outlier[j] ? &ns.median[j * 3] : y.pixel(qx, qy);
+          for (int c = 0; c < 3; ++c) sum[c] += q[c];
+          ++n;
+        }
+      for (int c = 0; c < 3; ++c, ++k) {
+        const double m = n ? sum[c] / n : 0.0;
+        w[k] = float(1.0 / (m * m + kRelMseEps));
+      }
+    }
+  return w;
+}
+
+Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthreads) {
+  Sample s;
+  const Roi outer = tile.grown(kMargin, frame.width, frame.height);
+  s.frame = crop(frame, outer);
+  s.inner = {tile.x0 - outer.x0, tile.y0 - outer.y0, tile.x1 - outer.x0, tile.y1 - outer.y0};
+  const Image& y = s.frame.image(Role::Colour);
+  s.noise = estimate_noise_scales(y, s.inner, nthreads);
+  s.weight = local_weights(y, s.noise, s.inner);
+  s.probed = s.frame;
+  // The pass the filters read as colour (find() picks among several by priority).
+  Pass* colour = const_cast<Pass*>(&s.probed.get(Role::Colour));
+  std::uint64_t st = 0x9E3779B97F4A7C15ull ^ (std::uint64_t(seed) * 0xBF58476D1CE4E5B9ull);
+  s.sign_over_eps.assign(std::size_t(s.inner.width()) * s.inner.height() * 3, 0.0f);
+  std::size_t k = 0;
+  for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
+    for (int x = s.inner.x0; x < s.inner.x1; ++x) {
+      const std::size_t i = s.noise.at(x, yy);
+      for (int c = 0; c < 3; ++c, ++k) {
+        st ^= st << 13;
+        st ^= st >> 7;
+        st ^= st << 17;
+        if (!s.noise.finite[i]) continue;
+        const double eps = std::max(kProbe * std::sqrt(s.noise.robust(i, c)), 1e-6);
+        const double b = (st >> 63) ? 1.0 : -1.0;
+        colour->image.at(x, yy, c) = float(double(colour->image.at(x, yy, c)) + b * eps);
+        s.sign_over_eps[k] = float(b / eps);
+      }
+    }
+  return s;
+}
+
+// Sums of the risk estimate of one candidate on one sample, relMSE-weighted.
+double risk(const Sample& s, const Image& f, const Image& fp) {
+  const Image& y = s.frame.image(Role::Colour);
+  double sum = 0;
+  std::size_t k = 0;
+  for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
+    for (int x = s.inner.x0; x < s.inner.x1; ++x) {
+      const std::size_t i = s.noise.at(x, yy);
+      for (int c = 0; c < 3; ++c, ++k) {
+        if (!s.noise.finite[i]) continue;
+        const double w = s.weight[k];
+        if (s.noise.outlier[i]) {
+          // A firefly: SURE's expectation (the local variance) would not see that this one
+          // is far out; score how far the result stays from the local median instead.
+          const double e = double(f.at(x, yy, c)) - double(s.noise.median[i * 3 + std::size_t(c)]);
+          sum += w * e * e;
+          continue;
+        }
+        const double v = s.noise.variance_of(i, c);
+        const double d = double(f.at(x, yy, c)) - double(y.at(x, yy, c));
+        const double div = double(s.sign_over_eps[k]) * (double(fp.at(x, yy, c)) - double(f.at(x, yy, c)));
+        sum += w * (d * d - v + 2.0 * v * div);
+      }
+    }
+  return sum;
+}
+
+double input_risk(const Sample& s, std::size_t& count) {
+  double sum = 0;
+  std::size_t k = 0;
+  for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
+    for (int x = s.inner.x0; x < s.inner.x1; ++x, k += 3) {
+      const std::size_t i = s.noise.at(x, yy);
+      if (!s.noise.finite[i]) continue;
+      const float* y = s.frame.image(Role::Colour).pixel(x, yy);
+      for (int c = 0; c < 3; ++c) {
+        const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
+        sum += (s.noise.outlier[i] ? e * e : s.noise.variance_of(i, c)) * s.weight[k + std::size_t(c)];
+      }
+      count += 3;
+    }
+  return sum;
+}
+
+}  // namespace
+
+const FilterInfo& AutoFilter::static_info() {
+  static const FilterInfo info = [] {
+    FilterInfo i;
+    i.name = "auto";
+    i.summary = "Chooses the filter for this render: every image filter the passes allow, scored by SURE on a sample, "
+                "the best run, or the input kept when none is estimated to help";
+    i.reference = "Stein's unbiased risk estimate (Stein 1981) with a Monte Carlo divergence (Ramani et al. 2008), "
+                  "over the project's filters with their defaults";
+    i.params = {
+        ParamSpec::Float("sample_fraction", 0.1, 0.01, 1.0,
+                         "share of the region's pixels the candidates are scored on (32x32 tiles on a grid; a small "
+                         "region is scored whole)"),
+        ParamSpec::Float("min_gain", 0.05, 0.0, 1.0,
+                         "a candidate must be estimated to cut the input's relMSE by this share, else the input is "
+                         "kept as it is"),
+    };
+    i.required = {Role::Colour};
+    i.optional = {Role::Normal,   Role::Position,       Role::Albedo,       Role::Depth,       Role::Variance,
+                  Role::SampleCount, Role::SecondPosition, Role::SecondNormal};
+    i.steps = PrepSteps::none();
+    i.nonfinite_policy = "as the filter it runs; a copied input has its non-finite values replaced by 0; non-finite "
+                         "pixels take no part in the scores";
+    return i;
+  }();
+  return info;
+}
+
+void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
+  (void)colour;
+  scores_.clear();
+  chosen_.clear();
+  // 1. Candidates: every image filter whose passes this frame has.
+  std::vector<std::unique_ptr<Filter>> cands;
+  std::string skipped;
+  for (const std::string& name : filter_names()) {
+    std::unique_ptr<Filter> f = make_filter(name);
+    if (f->info().temporal) continue;  // a still has no history; temporal filters run by name
+    const std::vector<Role> missing = f->missing_passes(frame);
+    if (!missing.empty()) {
+      skipped += (skipped.empty() ? "" : ", ") + name + " (no " + role_name(missing[0]) + " pass)";
+      continue;
+    }
+    f->commit();
+    cands.push_back(std::move(f));
+  }
+  if (!skipped.empty()) note("auto: candidates skipped: " + skipped);
+
+  // 2. Scores on the sample.
+  const std::vector<Roi> tiles = sample_tiles(roi, params_.get_float("sample_fraction"));
+  std::vector<Sample> samples;
+  double in_sum = 0;
+  std::size_t count = 0;
+  for (std::size_t t = 0; t < tiles.size(); ++t) {
+    samples.push_back(make_sample(frame, tiles[t], unsigned(t + 1), nthreads));
+    in_sum += input_risk(samples.back(), count);
+  }
+  const double n = std::max<double>(double(count), 1.0);
+  scores_.push_back({"input", in_sum / n, 0.0});
+  for (auto& f : cands) {
+    double r = 0;
+    const auto t0 = std::chrono::steady_clock::now();
+    for (const Sample& s : samples) {
+      ExecOptions eo;
+      eo.roi = s.inner;
+      eo.nthreads = nthreads;
+      const Image a = f->execute(s.frame, eo);
+      const Image b = f->execute(s.probed, eo);
+      r += risk(s, a, b);
+    }
+    const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    scores_.push_back({f->info().name, r / n, secs});
+  }
+  std::stable_sort(scores_.begin(), scores_.end(), [](const AutoScore& a, const AutoScore& b) { return a.relmse < b.relmse; });
+  std::string table;
+  for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + fixed(s.relmse, 3);
+  note("auto: estimated relMSE on " + std::to_string(tiles.size()) + (tiles.size() == 1 ? " sample (the whole region)" : " tiles") +
+       ": " + table);
+
+  // 3. The best, unless it is not estimated to beat the input by min_gain.
+  const double input_score = in_sum / n;
+  const AutoScore* best = nullptr;
+  for (const AutoScore& s : scores_)
+    if (s.filter != "input") {
+      best = &s;
+      break;
+    }
+  if (!best || !(best->relmse < (1.0 - params_.get_float("min_gain")) * input_score)) {
+    chosen_ = "input";
+    note("auto: chose the input as it is: no filter is estimated to cut its relMSE (" + fixed(input_score, 3) + ") by " +
+         fixed(100.0 * params_.get_float("min_gain"), 3) + "%");
+    return;  // out holds the input colour
+  }
+  chosen_ = best->filter;
+  for (auto& f : cands)
+    if (f->info().name == chosen_) {
+      ExecOptions eo;
+      eo.roi = roi;
+      eo.nthreads = nthreads;
+      out = f->execute(frame, eo);
+      note("auto: chose " + chosen_ + " with its defaults");
+      for (const std::string& m : f->notes()) note(chosen_ + ": " + m);
+      return;
+    }
+}
+
+}  // namespace mcr

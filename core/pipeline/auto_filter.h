@@ -1,0 +1,47 @@
+#pragma once
+// Filter `auto`: the right filter for each render, never worse than the input.
+//
+//  1. Inspect: every image filter whose passes the frame has is a candidate (with its
+//     defaults: each already skips constant or absent feature passes and steps back
+//     toward the input where it is not estimated to help, prepare/step_back.h).
+//  2. Score on a sample: tiles spread over the region (about sample_fraction of its
+//     pixels, each cropped with a margin so the filters see their neighbourhood). Each
+//     candidate's error on them is estimated by Stein's unbiased risk estimate, with its
+//     divergence by a Monte Carlo probe (Ramani et al. 2008: a second run on the input
+//     plus eps times random signs), the noise from kernels/noise_scale.h, every channel
+//     weighted as relMSE weighs it.
+//  3. Run the best on the whole region, or copy the input when no candidate is estimated
+//     to cut its error by min_gain (a converged render is left as it is).
+// What it chose, every score and what each stage skipped go to the notes (`--verbose`,
+// the plugin's and Python's notes).
+#include <string>
+#include <vector>
+
+#include "filters/filter.h"
+
+namespace mcr {
+
+struct AutoScore {
+  std::string filter;       // "input" for the input itself
+  double relmse = 0;        // estimated relMSE on the sample
+  double seconds = 0;       // time of its two runs on the sample
+};
+
+class AutoFilter : public Filter {
+ public:
+  AutoFilter() : Filter(static_info()) {}
+  static const FilterInfo& static_info();
+  // The scores of the last execute(), best first (empty when nothing was scored).
+  const std::vector<AutoScore>& scores() const { return scores_; }
+  // The filter the last execute() ran ("input" when it copied the input).
+  const std::string& chosen() const { return chosen_; }
+
+ protected:
+  void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
+
+ private:
+  std::vector<AutoScore> scores_;
+  std::string chosen_;
+};
+
+}  // namespace mcr
