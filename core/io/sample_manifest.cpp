@@ -34,6 +34,7 @@ std::vector<SampleScene> load_sample_manifest(const std::string& dir) {
       sc.name = s.at("name").get<std::string>();
       sc.kind = s.value("kind", std::string("still"));
       sc.description = s.value("description", std::string());
+      sc.split = s.value("split", std::string());
       sc.width = s.value("width", 0);
       sc.height = s.value("height", 0);
       for (const auto& [spp, path] : s.at("noisy").items()) {

@@ -9,6 +9,7 @@ namespace mcr {
 
 struct SampleScene {
   std::string name, kind, description;  // kind: "still" or "sequence"
+  std::string split;  // "tune": settings are chosen on it; "report": figures are reported on it
   int width = 0, height = 0;
   std::map<int, std::string> noisy;  // spp -> absolute path (a #### pattern for sequences)
   std::string reference;             // absolute path or pattern

@@ -11,7 +11,7 @@ namespace mcr {
 namespace {
 
 constexpr int kVarianceRadius = 3;
-constexpr int kTile = 4, kTileGrow = 4;
+constexpr int kTile = 8, kTileGrow = 4;
 constexpr double kRelativeEps = 1e-3;  // luminance^2 below which noise counts as absolute
 constexpr double kChi2MedianToMean = 1.27;
 constexpr double kFloorRelative = 0.02;
@@ -26,7 +26,20 @@ struct Rgb {
   const float* at(int x, int y) const { return img.pixel(x, y); }
 };
 
+// The median of 9 values by a fixed network of min/max exchanges (no branches).
+inline float median9(float* p) {
+  auto op = [p](int a, int b) {
+    const float lo = std::min(p[a], p[b]), hi = std::max(p[a], p[b]);
+    p[a] = lo;
+    p[b] = hi;
+  };
+  op(1, 2); op(4, 5); op(7, 8); op(0, 1); op(3, 4); op(6, 7); op(1, 2); op(4, 5); op(7, 8);
+  op(0, 3); op(5, 8); op(4, 7); op(3, 6); op(1, 4); op(2, 5); op(4, 7); op(4, 2); op(6, 4); op(4, 2);
+  return p[4];
+}
+
 float median_of(float* v, int n) {
+  if (n == 9) return median9(v);
   std::nth_element(v, v + n / 2, v + n);
   const float hi = v[n / 2];
   if (n % 2) return hi;
@@ -59,9 +72,20 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   s.median.assign(n * 3, 0.0f);
   s.finite.assign(n, 0);
   s.outlier.assign(n, 0);
+  s.excess.assign(n, 0.0f);
 
   // Region T: the tiles' windows. Medians and residual energies are needed there.
   const Roi T = s.box.grown(kTileGrow + kTile, W, H);
+  // Which pixels are finite, over T and the ring every neighbourhood reads around it.
+  const Roi F = T.grown(std::max(2, kVarianceRadius + 1), W, H);
+  std::vector<std::uint8_t> fin(std::size_t(F.width()) * std::size_t(F.height()), 0);
+  parallel_rows(F.y0, F.y1, nthreads, [&](int yy) {
+    for (int x = F.x0; x < F.x1; ++x) fin[std::size_t(yy - F.y0) * std::size_t(F.width()) + std::size_t(x - F.x0)] = y.finite(x, yy);
+  });
+  auto ok = [&](int x, int yy) {
+    return x >= F.x0 && yy >= F.y0 && x < F.x1 && yy < F.y1 &&
+           fin[std::size_t(yy - F.y0) * std::size_t(F.width()) + std::size_t(x - F.x0)];
+  };
   const int tw = T.width(), th = T.height();
   std::vector<float> med(std::size_t(tw) * std::size_t(th) * 3, 0.0f);
   std::vector<float> erel(std::size_t(tw) * std::size_t(th), 0.0f);
@@ -70,14 +94,14 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
     float vals[3][9];
     for (int x = T.x0; x < T.x1; ++x) {
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
-      if (!y.finite(x, yy)) continue;
+      if (!ok(x, yy)) continue;
       int k = 0;
       double nb[3] = {0, 0, 0};
       int nn = 0;
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int qx = x + dx, qy = yy + dy;
-          if (qx < 0 || qy < 0 || qx >= W || qy >= H || !y.finite(qx, qy)) continue;
+          if (!ok(qx, qy)) continue;
           const float* q = y.at(qx, qy);
           for (int c = 0; c < 3; ++c) vals[c][k] = q[c];
           ++k;
@@ -132,14 +156,13 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   static const int dirs[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
   parallel_rows(V.y0, V.y1, nthreads, [&](int yy) {
     for (int x = V.x0; x < V.x1; ++x) {
-      if (!y.finite(x, yy)) continue;
+      if (!ok(x, yy)) continue;
       const float* p = y.at(x, yy);
       double sum = 0;
       int cnt = 0;
       for (const auto& d : dirs) {
         const int ax = x - d[0], ay = yy - d[1], bx = x + d[0], by = yy + d[1];
-        if (ax < 0 || ay < 0 || ax >= W || ay >= H || bx < 0 || by < 0 || bx >= W || by >= H) continue;
-        if (!y.finite(ax, ay) || !y.finite(bx, by)) continue;
+        if (!ok(ax, ay) || !ok(bx, by)) continue;
         const float* a = y.at(ax, ay);
         const float* b = y.at(bx, by);
         for (int c = 0; c < 3; ++c) sum += (double(p[c]) - a[c]) * (double(p[c]) - b[c]);
@@ -153,7 +176,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   parallel_rows(s.box.y0, s.box.y1, nthreads, [&](int yy) {
     for (int x = s.box.x0; x < s.box.x1; ++x) {
       const std::size_t o = s.at(x, yy);
-      if (!y.finite(x, yy)) continue;
+      if (!ok(x, yy)) continue;
       s.finite[o] = 1;
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
       double dev = 0;
@@ -163,7 +186,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       for (int dy = -1; dy <= 1; ++dy)
         for (int dx = -1; dx <= 1; ++dx) {
           const int qx = x + dx, qy = yy + dy;
-          if ((!dx && !dy) || qx < 0 || qy < 0 || qx >= W || qy >= H || !y.finite(qx, qy)) continue;
+          if ((!dx && !dy) || !ok(qx, qy)) continue;
           const float* q = y.at(qx, qy);
           for (int c = 0; c < 3; ++c) {
             lo[c] = any ? std::min(lo[c], q[c]) : q[c];
@@ -177,6 +200,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
         const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
         dev += out * out / std::max(s.robust(o, c), 1e-30);
       }
+      s.excess[o] = float(std::min(dev / 3.0, 3.0e38));
       s.outlier[o] = dev / 3.0 > kOutlierSigmas * kOutlierSigmas ? 1 : 0;
       s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0), 0.0), 3.0e38));
     }

@@ -19,6 +19,8 @@
 //                converged render still has a scale). Monte Carlo noise grows with the
 //                value, so a dark channel next to a bright one keeps a small scale.
 //   variance(p,c) variance(p) shared among the channels in the same proportion.
+//   excess(p)    mean over R, G, B of the squared distance by which y(p) lies beyond the
+//                range of its 8 finite neighbours, in units of robust(p, c);
 //   outlier(p)   y(p) lies beyond the range of its 8 finite neighbours by more than 4
 //                robust deviations (mean over R, G, B of the squared excess > 16 robust(p)):
 //                a firefly (or a one-pixel highlight); a block's corner is not one.
@@ -38,7 +40,8 @@ struct NoiseScales {
   std::vector<float> relative;      // one per pixel
   std::vector<float> median;        // three per pixel (RGB)
   std::vector<std::uint8_t> finite; // the pixel's RGB is finite
-  std::vector<std::uint8_t> outlier;
+  std::vector<float> excess;        // mean over R, G, B of (distance beyond the neighbours' range)^2 / robust
+  std::vector<std::uint8_t> outlier; // excess > kOutlierSigmas^2
   std::size_t at(int x, int y) const {
     return std::size_t(y - box.y0) * std::size_t(box.width()) + std::size_t(x - box.x0);
   }

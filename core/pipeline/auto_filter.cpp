@@ -14,8 +14,12 @@ namespace mcr {
 
 namespace {
 
-constexpr int kTile = 32;          // scored tile side
-constexpr int kMargin = 32;        // what a candidate sees around a tile
+constexpr int kTile = 64;          // scored tile side
+constexpr int kMargin = 16;        // what a candidate sees around a tile (its result there is not scored)
+constexpr int kMinTiles = 4;
+// A pixel beyond its neighbours' range by this many robust deviations is scored by its
+// distance to the local median: SURE's expectation cannot see that this sample is far out.
+constexpr double kScoreSigmas = 2.0;
 constexpr double kRelMseEps = 0.01;
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
 
@@ -50,8 +54,8 @@ Frame crop(const Frame& f, const Roi& r) {
 // roi as one tile when it is small.
 std::vector<Roi> sample_tiles(const Roi& roi, double fraction) {
   const double area = double(roi.width()) * roi.height();
-  const double want = std::max(1.0, std::round(fraction * area / (kTile * kTile)));
-  if (roi.width() < 3 * kTile || roi.height() < 3 * kTile || want * kTile * kTile >= 0.5 * area) return {roi};
+  const double want = std::max(double(kMinTiles), std::round(fraction * area / (kTile * kTile)));
+  if (roi.width() < 2 * kTile || roi.height() < 2 * kTile || want * kTile * kTile >= 0.5 * area) return {roi};
   const int nx = std::max(1, int(std::round(std::sqrt(want * roi.width() / roi.height()))));
   const int ny = std::max(1, int(std::round(want / nx)));
   std::vector<Roi> tiles;
@@ -142,7 +146,7 @@ double risk(const Sample& s, const Image& f, const Image& fp) {
       for (int c = 0; c < 3; ++c, ++k) {
         if (!s.noise.finite[i]) continue;
         const double w = s.weight[k];
-        if (s.noise.outlier[i]) {
+        if (s.noise.excess[i] > kScoreSigmas * kScoreSigmas) {
           // A firefly: SURE's expectation (the local variance) would not see that this one
           // is far out; score how far the result stays from the local median instead.
           const double e = double(f.at(x, yy, c)) - double(s.noise.median[i * 3 + std::size_t(c)]);
@@ -167,8 +171,9 @@ double input_risk(const Sample& s, std::size_t& count) {
       if (!s.noise.finite[i]) continue;
       const float* y = s.frame.image(Role::Colour).pixel(x, yy);
       for (int c = 0; c < 3; ++c) {
+        const bool far = s.noise.excess[i] > kScoreSigmas * kScoreSigmas;
         const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
-        sum += (s.noise.outlier[i] ? e * e : s.noise.variance_of(i, c)) * s.weight[k + std::size_t(c)];
+        sum += (far ? e * e : s.noise.variance_of(i, c)) * s.weight[k + std::size_t(c)];
       }
       count += 3;
     }
@@ -186,9 +191,9 @@ const FilterInfo& AutoFilter::static_info() {
     i.reference = "Stein's unbiased risk estimate (Stein 1981) with a Monte Carlo divergence (Ramani et al. 2008), "
                   "over the project's filters with their defaults";
     i.params = {
-        ParamSpec::Float("sample_fraction", 0.1, 0.01, 1.0,
-                         "share of the region's pixels the candidates are scored on (32x32 tiles on a grid; a small "
-                         "region is scored whole)"),
+        ParamSpec::Float("sample_fraction", 0.04, 0.001, 1.0,
+                         "share of the region's pixels the candidates are scored on (64x64 tiles on a grid, at least 4; "
+                         "a region too small for that is scored whole)"),
         ParamSpec::Float("min_gain", 0.05, 0.0, 1.0,
                          "a candidate must be estimated to cut the input's relMSE by this share, else the input is "
                          "kept as it is"),
