@@ -149,11 +149,13 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
     }
   });
 
-  // z(q) = mean over 4 directions d and R, G, B of (y(q) - y(q - d)) (y(q) - y(q + d)), over
+  // z(q) = mean over the 2 axis directions d and R, G, B of (y(q) - y(q - d)) (y(q) - y(q + d)), over
   // the box grown by the variance window.
   const Roi V = s.box.grown(kVarianceRadius, W, H);
   WindowSums z(V.width(), V.height());
-  static const int dirs[4][2] = {{1, 0}, {0, 1}, {1, 1}, {1, -1}};
+  // Along the axes only: at a corner where four blocks meet, a diagonal has a different
+  // value on each side and would count the corner as noise; an axis never does.
+  static const int dirs[2][2] = {{1, 0}, {0, 1}};
   parallel_rows(V.y0, V.y1, nthreads, [&](int yy) {
     for (int x = V.x0; x < V.x1; ++x) {
       if (!ok(x, yy)) continue;

@@ -3,11 +3,13 @@
 // pass, no second buffer), for the step back (prepare/step_back.h) and `auto`:
 //
 //   variance(p)  the variance of one pixel's noise (mean over R, G, B): the mean over the
-//                (2*3+1)^2 window, 4 directions d and R, G, B of
+//                (2*3+1)^2 window, the 2 axis directions d and R, G, B of
 //                (y(q) - y(q - d)) (y(q) - y(q + d)), at least 0. For pixel-independent
 //                noise of variance s^2 its expectation is s^2; a step edge adds exactly 0
-//                (one factor is 0 on either side of it), a ramp of slope g adds -g^2, so
-//                edges cancel and smooth shading or a pixel filter's blur make it err low.
+//                (one factor is 0 on either side of it; along the axes this holds at a
+//                corner where four regions meet and on a pixel staircase too, which a
+//                diagonal would not), a ramp of slope g adds -g^2, so edges cancel and
+//                smooth shading or a pixel filter's blur make it err low.
 //                A one-pixel peak counts as noise.
 //   median(p)    per-channel median of the finite pixels of the 3x3 neighbourhood.
 //   relative(p)  a relative noise level sparse bright structure cannot inflate: the

@@ -194,6 +194,9 @@ const FilterInfo& AutoFilter::static_info() {
         ParamSpec::Float("sample_fraction", 0.04, 0.001, 1.0,
                          "share of the region's pixels the candidates are scored on (64x64 tiles on a grid, at least 4; "
                          "a region too small for that is scored whole)"),
+        ParamSpec::Float("converged", 1e-4, 0.0, 1.0,
+                         "an input whose estimated relMSE is below this is kept as it is (1e-4: a relative noise of 1%, "
+                         "below what anyone sees); 0 = always filter"),
         ParamSpec::Float("min_gain", 0.05, 0.0, 1.0,
                          "a candidate must be estimated to cut the input's relMSE by this share, else the input is "
                          "kept as it is"),
@@ -262,6 +265,12 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
 
   // 3. The best, unless it is not estimated to beat the input by min_gain.
   const double input_score = in_sum / n;
+  if (input_score < params_.get_float("converged")) {
+    chosen_ = "input";
+    note("auto: chose the input as it is: converged (estimated relMSE " + fixed(input_score, 3) + " < converged=" +
+         fixed(params_.get_float("converged"), 3) + ")");
+    return;
+  }
   const AutoScore* best = nullptr;
   for (const AutoScore& s : scores_)
     if (s.filter != "input") {

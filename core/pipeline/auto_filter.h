@@ -10,8 +10,8 @@
 //     divergence by a Monte Carlo probe (Ramani et al. 2008: a second run on the input
 //     plus eps times random signs), the noise from kernels/noise_scale.h, every channel
 //     weighted as relMSE weighs it.
-//  3. Run the best on the whole region, or copy the input when no candidate is estimated
-//     to cut its error by min_gain (a converged render is left as it is).
+//  3. Run the best on the whole region, or copy the input when its own estimated relMSE
+//     is below `converged` or no candidate is estimated to cut it by min_gain.
 // What it chose, every score and what each stage skipped go to the notes (`--verbose`,
 // the plugin's and Python's notes).
 #include <string>

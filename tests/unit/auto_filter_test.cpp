@@ -1,0 +1,148 @@
+// pipeline/auto_filter: what it chooses on renders whose truth is known, what it reports,
+// and that its result is the chosen filter's.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include "feature_filter_testutil.h"
+#include "filters/registry.h"
+#include "pipeline/auto_filter.h"
+#include "pipeline/filter_catalog.h"
+#include "util/error.h"
+
+namespace mcr {
+namespace {
+
+// Blocks of 16 px (levels in [0.1, 1.5], one albedo per block), a normal per block, noise of
+// relative deviation `sigma`. The features explain every edge.
+Frame blocks(int w, int h, double sigma, unsigned seed, Image* clean_out) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> level(0.1f, 1.5f);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  const int bw = w / 16 + 1;
+  std::vector<float> lv(std::size_t(bw * (h / 16 + 1)) * 3);
+  for (float& v : lv) v = level(rng);
+  Image clean(w, h, 3), noisy(w, h, 3), albedo(w, h, 3), normal(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const std::size_t b = std::size_t((y / 16) * bw + x / 16);
+      for (int c = 0; c < 3; ++c) {
+        const float v = lv[b * 3 + std::size_t(c)] * (0.8f + 0.4f * float(y) / float(h));
+        clean.at(x, y, c) = v;
+        noisy.at(x, y, c) = std::max(0.0f, v * (1.0f + float(sigma) * noise(rng)));
+        albedo.at(x, y, c) = lv[b * 3 + std::size_t(c)] / 1.5f;
+      }
+      const float a = 0.3f * float(b % 5);
+      normal.at(x, y, 0) = std::sin(a);
+      normal.at(x, y, 1) = 0.0f;
+      normal.at(x, y, 2) = std::cos(a);
+    }
+  *clean_out = clean;
+  Frame f = testutil::colour_frame(noisy);
+  testutil::add_pass(f, Role::Albedo, albedo);
+  testutil::add_pass(f, Role::Normal, normal);
+  return f;
+}
+
+double relmse(const Image& a, const Image& ref) {
+  double s = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(a.at(x, y, c)) - ref.at(x, y, c);
+        s += d * d / (double(ref.at(x, y, c)) * ref.at(x, y, c) + 0.01);
+      }
+  return s / (3.0 * double(a.pixel_count()));
+}
+
+Image run_auto(const Frame& f, AutoFilter& a, Roi roi = {}) {
+  a.commit();
+  ExecOptions eo;
+  eo.roi = roi;
+  eo.nthreads = 2;
+  return a.execute(f, eo);
+}
+
+TEST(AutoFilter, ANoisyRenderIsFilteredAndTheChoiceIsAmongTheBest) {
+  for (double sigma : {0.2, 0.6}) {
+    SCOPED_TRACE(sigma);
+    Image clean;
+    const Frame f = blocks(160, 128, sigma, 3, &clean);
+    AutoFilter a;
+    const Image out = run_auto(f, a);
+    ASSERT_NE(a.chosen(), "input");
+    const double in_err = relmse(f.image(Role::Colour), clean), err = relmse(out, clean);
+    EXPECT_LT(err, 0.3 * in_err);
+    // Within 2x of the best candidate's true error (the oracle: every candidate run whole).
+    double best = 1e300;
+    for (const std::string& name : filter_names()) {
+      auto c = make_filter(name);
+      if (c->info().temporal || !c->missing_passes(f).empty()) continue;
+      c->commit();
+      best = std::min(best, relmse(c->execute(f), clean));
+    }
+    EXPECT_LT(err, 2.0 * best);
+  }
+}
+
+TEST(AutoFilter, ACleanRenderIsKeptAsItIs) {
+  Image clean;
+  Frame f = blocks(160, 128, 0.0, 4, &clean);
+  AutoFilter a;
+  const Image out = run_auto(f, a);
+  EXPECT_EQ(a.chosen(), "input");
+  EXPECT_EQ(out.storage(), clean.storage());
+}
+
+TEST(AutoFilter, ItsResultIsTheChosenFiltersAndItReportsTheScores) {
+  Image clean;
+  const Frame f = blocks(160, 128, 0.3, 5, &clean);
+  AutoFilter a;
+  const Image out = run_auto(f, a);
+  ASSERT_NE(a.chosen(), "input");
+  auto c = make_filter(a.chosen());
+  c->commit();
+  ExecOptions eo;
+  eo.nthreads = 2;
+  EXPECT_EQ(out.storage(), c->execute(f, eo).storage());
+  // Scores: the input and every filter whose passes are present, best first.
+  ASSERT_GE(a.scores().size(), 2u);
+  for (std::size_t i = 1; i < a.scores().size(); ++i) EXPECT_LE(a.scores()[i - 1].relmse, a.scores()[i].relmse);
+  bool est = false, chose = false, skipped = false;
+  for (const std::string& n : a.notes()) {
+    est = est || n.rfind("auto: estimated relMSE", 0) == 0;
+    chose = chose || n == "auto: chose " + a.chosen() + " with its defaults";
+    skipped = skipped || n.find("guided (no depth pass)") != std::string::npos;  // the frame has no depth
+  }
+  EXPECT_TRUE(est && chose && skipped);
+}
+
+TEST(AutoFilter, OnlyTheRegionChangesAndNothingNonFiniteLeaves) {
+  Image clean;
+  Frame f = blocks(160, 128, 0.3, 6, &clean);
+  Image& y = f.passes[0].image;
+  y.at(50, 40, 0) = std::numeric_limits<float>::quiet_NaN();
+  y.at(51, 40, 1) = std::numeric_limits<float>::infinity();
+  const Roi roi{20, 10, 140, 100};
+  AutoFilter a;
+  const Image out = run_auto(f, a, roi);
+  for (int yy = 0; yy < 128; ++yy)
+    for (int x = 0; x < 160; ++x)
+      for (int c = 0; c < 3; ++c) {
+        ASSERT_TRUE(std::isfinite(out.at(x, yy, c)));
+        if (!roi.contains(x, yy)) EXPECT_EQ(out.at(x, yy, c), y.at(x, yy, c));
+      }
+}
+
+TEST(AutoFilter, TheCatalogNamesIt) {
+  const std::vector<std::string> names = catalog_names();
+  EXPECT_EQ(names.back(), "auto");
+  EXPECT_EQ(catalog_info("auto").name, "auto");
+  EXPECT_NE(dynamic_cast<AutoFilter*>(make_catalog_filter("auto").get()), nullptr);
+  EXPECT_THROW(make_catalog_filter("autox"), Error);
+}
+
+}  // namespace
+}  // namespace mcr
