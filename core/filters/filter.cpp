@@ -169,9 +169,10 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   repaired_ = finish(prepared_, input, roi, nthreads, out);
   if (repaired_) note(std::to_string(repaired_) + " non-finite output values replaced by 0");
   if (info_.steps.step_back && params_.get_bool("step_back")) {
-    const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi,
-                                       int(params_.get_int("step_back_radius")), nthreads, out);
-    note("step_back: mean weight of the filtered result " + fixed_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
+    const Pass* variance = prepared_.frame->find(Role::Variance);
+    const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
+                                       nthreads, out, variance ? &variance->image : nullptr);
+    note(std::string("step_back") + (variance ? " (noise from the variance pass)" : "") + ": mean weight of the filtered result " + fixed_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          fixed_text(100.0 * sb.input_share, 1) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
   prepared_.own = Frame{};  // the copied passes are not kept between frames

@@ -60,7 +60,7 @@ double NoiseScales::variance_of(std::size_t i, int c) const {
   return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(&median[i * 3]) + kRelativeEps);
 }
 
-NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads) {
+NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads, const Image* vpass) {
   const int W = colour.width(), H = colour.height();
   NoiseScales s;
   s.box = box_in.clipped(W, H);
@@ -156,8 +156,23 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   // Along the axes only: at a corner where four blocks meet, a diagonal has a different
   // value on each side and would count the corner as noise; an axis never does.
   static const int dirs[2][2] = {{1, 0}, {0, 1}};
+  const bool use_pass = vpass && vpass->width() == W && vpass->height() == H && vpass->channels() > 0;
   parallel_rows(V.y0, V.y1, nthreads, [&](int yy) {
     for (int x = V.x0; x < V.x1; ++x) {
+      if (use_pass) {
+        const float* v = vpass->pixel(x, yy);
+        const int vc = std::min(3, vpass->channels());
+        double sum = 0;
+        bool good = true;
+        for (int c = 0; c < vc; ++c) {
+          good = good && std::isfinite(v[c]) && v[c] >= 0.0f;
+          sum += v[c];
+        }
+        if (good) {
+          z.set(x - V.x0, yy - V.y0, sum / vc, 1.0);
+          continue;
+        }
+      }
       if (!ok(x, yy)) continue;
       const float* p = y.at(x, yy);
       double sum = 0;

@@ -54,8 +54,11 @@ struct NoiseScales {
 
 constexpr double kOutlierSigmas = 4.0;  // outlier: further than this many robust deviations
 
-// Scales for the pixels of `box` (clipped to the image); reads up to 5 pixels around it.
-// colour: RGB in its first three channels.
-NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads);
+// Scales for the pixels of `box` (clipped to the image); reads up to 12 pixels around it.
+// colour: RGB in its first three channels. variance: a variance pass (the variance of each
+// pixel's value: a renderer's, or (A - B)^2 / 4 from two half buffers), or null; where it
+// is given, finite and >= 0, `variance` is its mean over the channels and the same window
+// instead of the estimate from the image (exact in expectation, no signal in it).
+NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads, const Image* variance = nullptr);
 
 }  // namespace mcr

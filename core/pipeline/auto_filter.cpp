@@ -110,7 +110,8 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   s.frame = crop(frame, outer);
   s.inner = {tile.x0 - outer.x0, tile.y0 - outer.y0, tile.x1 - outer.x0, tile.y1 - outer.y0};
   const Image& y = s.frame.image(Role::Colour);
-  s.noise = estimate_noise_scales(y, s.inner, nthreads);
+  const Pass* variance = s.frame.find(Role::Variance);
+  s.noise = estimate_noise_scales(y, s.inner, nthreads, variance ? &variance->image : nullptr);
   s.weight = local_weights(y, s.noise, s.inner);
   s.probed = s.frame;
   // The pass the filters read as colour (find() picks among several by priority).

@@ -20,12 +20,13 @@ double clamp_float(double v) { return std::min(std::max(v, -double(kMax)), doubl
 
 }  // namespace
 
-StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int nthreads, Image& out) {
+StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int nthreads, Image& out,
+                        const Image* variance) {
   StepBackStats st;
   const int W = input.width(), H = input.height();
   const Roi roi = roi_in.clipped(W, H);
   if (roi.empty()) return st;
-  const NoiseScales ns = estimate_noise_scales(input, roi, nthreads);
+  const NoiseScales ns = estimate_noise_scales(input, roi, nthreads, variance);
   const int rw = roi.width(), rh = roi.height();
 
   // The window sums of the blend weight's numerator and denominator, over the roi only

@@ -32,7 +32,9 @@ struct StepBackStats {
 };
 
 // input: the colour the filter was given (RGB in its first channels, the frame's size);
-// out: the filter's RGB result, changed inside roi only.
-StepBackStats step_back(const Image& input, const Roi& roi, int radius, int nthreads, Image& out);
+// out: the filter's RGB result, changed inside roi only; variance: the frame's variance
+// pass or null (kernels/noise_scale.h).
+StepBackStats step_back(const Image& input, const Roi& roi, int radius, int nthreads, Image& out,
+                        const Image* variance = nullptr);
 
 }  // namespace mcr

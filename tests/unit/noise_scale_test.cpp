@@ -86,6 +86,28 @@ TEST(NoiseScale, FireflyIsAnOutlierAndDoesNotInflateTheRobustScale) {
     }
 }
 
+// A one-pixel checkerboard is all signal the image-only estimate cannot tell from noise;
+// a variance pass (as two half buffers give) tells it.
+TEST(NoiseScale, AVariancePassIsUsedWhereItIsValid) {
+  const int w = 64, h = 48;
+  std::mt19937 rng(9);
+  std::normal_distribution<float> noise(0.0f, 0.05f);
+  Image im(w, h, 3), var(w, h, 1, 0.05f * 0.05f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) = ((x + y) % 2 ? 1.0f : 0.3f) + noise(rng);
+  const NoiseScales without = estimate_noise_scales(im, Roi::all(w, h), 1);
+  EXPECT_GT(mean_over(without.variance), 10 * 0.05 * 0.05);
+  const NoiseScales with = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
+  EXPECT_NEAR(mean_over(with.variance), 0.05 * 0.05, 1e-6);
+  // Invalid pass values fall back to the estimate there.
+  for (int x = 0; x < w; ++x)
+    for (int y = 0; y < 16; ++y) var.at(x, y, 0) = -1.0f;
+  const NoiseScales part = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
+  EXPECT_GT(part.variance[part.at(30, 2)], 10 * 0.05 * 0.05);
+  EXPECT_NEAR(part.variance[part.at(30, 40)], 0.05 * 0.05, 1e-6);
+}
+
 TEST(NoiseScale, NonFinitePixelsTakeNoPart) {
   Image im = blocks(32, 32, 5, 0.05);
   const NoiseScales ref = estimate_noise_scales(im, Roi::all(32, 32), 1);
