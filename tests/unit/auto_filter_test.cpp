@@ -17,7 +17,7 @@ namespace {
 
 // Blocks of 16 px (levels in [0.1, 1.5], one albedo per block), a normal per block, noise of
 // relative deviation `sigma`. The features explain every edge.
-Frame blocks(int w, int h, double sigma, unsigned seed, Image* clean_out) {
+Frame blocks(int w, int h, double sigma, unsigned seed, Image* clean_out, double fireflies = 0.0) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> level(0.1f, 1.5f);
   std::normal_distribution<float> noise(0.0f, 1.0f);
@@ -32,6 +32,11 @@ Frame blocks(int w, int h, double sigma, unsigned seed, Image* clean_out) {
         const float v = lv[b * 3 + std::size_t(c)] * (0.8f + 0.4f * float(y) / float(h));
         clean.at(x, y, c) = v;
         noisy.at(x, y, c) = std::max(0.0f, v * (1.0f + float(sigma) * noise(rng)));
+      }
+      // Monte Carlo's heavy tail: a few samples far out.
+      if (fireflies > 0 && std::uniform_real_distribution<double>(0, 1)(rng) < fireflies)
+        for (int c = 0; c < 3; ++c) noisy.at(x, y, c) *= 30.0f;
+      for (int c = 0; c < 3; ++c) {
         albedo.at(x, y, c) = lv[b * 3 + std::size_t(c)] / 1.5f;
       }
       const float a = 0.3f * float(b % 5);
@@ -66,10 +71,10 @@ Image run_auto(const Frame& f, AutoFilter& a, Roi roi = {}) {
 }
 
 TEST(AutoFilter, ANoisyRenderIsFilteredAndTheChoiceIsAmongTheBest) {
-  for (double sigma : {0.2, 0.6}) {
-    SCOPED_TRACE(sigma);
+  for (auto [sigma, fireflies] : {std::pair{0.2, 0.0}, std::pair{0.6, 0.0}, std::pair{0.3, 0.01}}) {
+    SCOPED_TRACE(testing::Message() << sigma << " fireflies " << fireflies);
     Image clean;
-    const Frame f = blocks(160, 128, sigma, 3, &clean);
+    const Frame f = blocks(160, 128, sigma, 3, &clean, fireflies);
     AutoFilter a;
     const Image out = run_auto(f, a);
     ASSERT_NE(a.chosen(), "input");
