@@ -152,7 +152,11 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   // z(q) = mean over the 2 axis directions d and R, G, B of (y(q) - y(q - d)) (y(q) - y(q + d)), over
   // the box grown by the variance window.
   const Roi V = s.box.grown(kVarianceRadius, W, H);
-  WindowSums z(V.width(), V.height());
+  // Kept between frames (no fresh pages each time); referenced by name here, because a
+  // thread_local named inside the parallel lambdas would be each worker's own.
+  thread_local WindowSums z_kept;
+  WindowSums& z = z_kept;
+  z.reset(V.width(), V.height());
   // Along the axes only: at a corner where four blocks meet, a diagonal has a different
   // value on each side and would count the corner as noise; an axis never does.
   static const int dirs[2][2] = {{1, 0}, {0, 1}};

@@ -31,7 +31,13 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
 
   // The window sums of the blend weight's numerator and denominator, over the roi only
   // (outside it the result is the input).
-  WindowSums num(rw, rh), den(rw, rh);
+  // Kept between frames (no fresh pages each time); referenced by name here, because a
+  // thread_local named inside the parallel lambdas would be each worker's own.
+  thread_local WindowSums num_kept, den_kept;
+  WindowSums& num = num_kept;
+  WindowSums& den = den_kept;
+  num.reset(rw, rh, false);
+  den.reset(rw, rh, false);
   parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
     for (int x = roi.x0; x < roi.x1; ++x) {
       const std::size_t i = ns.at(x, y);
@@ -46,8 +52,8 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
         nv += w * ns.variance_of(i, c);
         dv += w * d * d;
       }
-      num.set(x - roi.x0, y - roi.y0, nv, 0.0);
-      den.set(x - roi.x0, y - roi.y0, std::min(dv, 1e300), 0.0);
+      num.set(x - roi.x0, y - roi.y0, nv);
+      den.set(x - roi.x0, y - roi.y0, std::min(dv, 1e300));
     }
   });
   num.sum_windows(radius, nthreads);
