@@ -43,7 +43,7 @@ float median_of(float* v, int n) {
   std::nth_element(v, v + n / 2, v + n);
   const float hi = v[n / 2];
   if (n % 2) return hi;
-  return 0.5f * (*std::max_element(v, v + n / 2) + hi);
+  return 0.5f * *std::max_element(v, v + n / 2) + 0.5f * hi;  // halves first: no overflow near FLT_MAX
 }
 
 double luminance2(const float* m) { return (double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0; }
