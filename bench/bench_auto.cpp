@@ -4,7 +4,9 @@
 //   mcrecon_bench_auto [--spp 16] [--threads 2] [--repeat 3] [--scenes a,b]
 // Then the skip row: `wall` with its constant normal and depth passes as rendered,
 // against the same frame with a faint ripple in them (over the skip tolerance, so they
-// are used): auto's time at equal error (issue 14, point 4).
+// are used): auto's time at equal error (issue 14, point 4). Last, on the scenes with half
+// buffers: auto and every filter at full size on the 16-spp file (noise estimated from the
+// image) against the mean of its two halves (noise from their difference).
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -14,6 +16,8 @@
 #include <vector>
 
 #include "filters/registry.h"
+#include "io/frame_reader.h"
+#include "io/half_buffers.h"
 #include "io/sample_manifest.h"
 #include "metrics/metrics.h"
 #include "pipeline/auto_filter.h"
@@ -117,6 +121,20 @@ int main(int argc, char** argv) {
       const Run b = time_filter("auto", ripple, ref, threads, repeat);
       std::printf("%-9s %-6s %-10s %9.4f %9.4f %10.5f   (normal/depth rippled, so used): chose %s\n", "wall", scene.split.c_str(),
                   "auto", b.seconds, b.seconds / mp, b.relmse, b.chosen.c_str());
+    }
+  }
+  std::printf("\nHalf buffers (%d spp, full size): noise from the image alone | from the halves' difference\n", spp);
+  for (const mcr::SampleScene& scene : mcr::load_sample_manifest(mcr::default_samples_dir())) {
+    if (!scene.halves.count(spp) || !mcr::bench::wanted(scenes_wanted, scene.name)) continue;
+    const mcr::Frame single = mcr::read_frame(scene.noisy.at(spp));
+    const mcr::Frame halves = mcr::combine_halves(mcr::read_frame(scene.halves.at(spp).first),
+                                                  mcr::read_frame(scene.halves.at(spp).second));
+    const mcr::Image ref = mcr::read_frame(scene.reference).image(mcr::Role::Colour).channel_range(0, 3);
+    for (const std::string& name : mcr::catalog_names()) {
+      if (mcr::catalog_info(name).temporal) continue;
+      const Run a = time_filter(name, single, ref, threads, 1), b = time_filter(name, halves, ref, threads, 1);
+      std::printf("%-9s %-10s %10.5f %10.5f %s%s\n", scene.name.c_str(), name.c_str(), a.relmse, b.relmse,
+                  a.chosen.empty() ? "" : ("chose " + a.chosen + " | " + b.chosen).c_str(), "");
     }
   }
   return 0;

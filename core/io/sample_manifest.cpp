@@ -46,6 +46,15 @@ std::vector<SampleScene> load_sample_manifest(const std::string& dir) {
                                                  "' has a noisy entry '" + spp + "' that is not a sample count");
         sc.noisy[int(n)] = (fs::path(dir) / path.get<std::string>()).string();
       }
+      if (s.contains("halves"))
+        for (const auto& [spp, pair] : s.at("halves").items()) {
+          const int n = std::atoi(spp.c_str());
+          if (n <= 0 || !pair.is_array() || pair.size() != 2)
+            throw Error(Errc::InvalidArgument, "sample manifest '" + file.string() + "': scene '" + sc.name +
+                                                   "' has a halves entry '" + spp + "' that is not two files of a sample count");
+          sc.halves[n] = {(fs::path(dir) / pair.at(0).get<std::string>()).string(),
+                          (fs::path(dir) / pair.at(1).get<std::string>()).string()};
+        }
       sc.reference = (fs::path(dir) / s.at("reference").get<std::string>()).string();
       sc.reference_spp = s.value("reference_spp", 0);
       if (s.contains("frames")) {

@@ -3,6 +3,7 @@
 // the benchmarks and the end-to-end tests.
 #include <map>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace mcr {
@@ -12,6 +13,7 @@ struct SampleScene {
   std::string split;  // "tune": settings are chosen on it; "report": figures are reported on it
   int width = 0, height = 0;
   std::map<int, std::string> noisy;  // spp -> absolute path (a #### pattern for sequences)
+  std::map<int, std::pair<std::string, std::string>> halves;  // spp -> its two half buffers
   std::string reference;             // absolute path or pattern
   int reference_spp = 0;
   int first_frame = 1, last_frame = 1;  // sequences
