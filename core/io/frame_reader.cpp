@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <set>
 
+#include "io/half_buffers.h"
 #include "io/channel_roles.h"
 #include "io/input_limits.h"
 #include "io/spec_window.h"
@@ -210,6 +211,7 @@ std::vector<std::string> loose_pass_files(const ReadOptions& options) {
     std::error_code ec;
     if (fs::is_regular_file(o.value, ec)) files.push_back(o.value);
   }
+  if (!options.second_half.empty()) files.push_back(options.second_half);
   return files;
 }
 
@@ -302,6 +304,11 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
 }  // namespace
 
 Frame read_frame(const std::string& path, const ReadOptions& options) {
+  if (!options.second_half.empty()) {
+    ReadOptions one = options;
+    one.second_half.clear();
+    return combine_halves(frame_from_raw(read_raw(path), path, one), read_frame(options.second_half, one));
+  }
   return frame_from_raw(read_raw(path), path, options);
 }
 

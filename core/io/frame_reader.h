@@ -18,13 +18,15 @@ struct ReadOptions {
   std::vector<PassOverride> overrides;  // --pass ROLE=VALUE
   bool require_colour = true;           // MissingPass when no colour pass is found
   bool keep_extra = false;              // fill Frame::extra with every unused channel group
+  std::string second_half;              // the other half buffer of this render (io/half_buffers.h): the
+                                        // frame is their mean, with a variance pass from their difference
 };
 
 // Parses "normal=normals.exr" into an override; throws InvalidArgument.
 PassOverride parse_pass_override(const std::string& text);
 
-// The overrides that name a file (not a channel group): inputs of the run, which no
-// output may overwrite.
+// The overrides that name a file (not a channel group) and the second half buffer: inputs
+// of the run, which no output may overwrite.
 std::vector<std::string> loose_pass_files(const ReadOptions& options);
 
 // Reads every pass of the file (deep files: the per-sample buffer plus the

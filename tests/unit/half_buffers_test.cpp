@@ -88,6 +88,11 @@ TEST(HalfBuffers, SampleHalvesGiveThe16SppRenderAndItsNoise) {
         }
       std::nth_element(ratio.begin(), ratio.begin() + long(ratio.size() / 2), ratio.end());
       EXPECT_LT(std::abs(ratio[ratio.size() / 2]), std::log2(1.5));
+      // The reader does the same when given the second half.
+      ReadOptions ro;
+      ro.second_half = pair.second;
+      EXPECT_EQ(read_frame(pair.first, ro).image(Role::Colour).storage(), y.storage());
+      EXPECT_EQ(loose_pass_files(ro), std::vector<std::string>{pair.second});  // an input: never an output
       ++checked;
     }
   }
