@@ -4,12 +4,12 @@
 #include <set>
 
 #include "commands.h"
-#include "filters/registry.h"
 #include "io/atomic_write.h"
 #include "io/preview.h"
 #include "io/sample_manifest.h"
 #include "json_views.h"
 #include "pipeline/evaluate.h"
+#include "pipeline/filter_catalog.h"
 #include "progress.h"
 #include "util/error.h"
 #include "validators.h"
@@ -59,8 +59,8 @@ void check_spp(const std::vector<int>& spp, const std::vector<SampleScene>& scen
 int run_demo(const DemoArgs& a) {
   const std::string dir = a.samples.empty() ? default_samples_dir() : a.samples;
   const std::vector<SampleScene> scenes = load_sample_manifest(dir);
-  std::vector<std::string> filters = a.filters.empty() ? filter_names() : a.filters;
-  for (const auto& f : filters) filter_info(f);  // unknown names fail before any work
+  std::vector<std::string> filters = a.filters.empty() ? catalog_names() : a.filters;
+  for (const auto& f : filters) catalog_info(f);  // unknown names fail before any work
   if (a.spp_given) check_spp(a.spp, scenes, dir);
   std::filesystem::create_directories(a.out);
 
@@ -87,7 +87,7 @@ int run_demo(const DemoArgs& a) {
         print_row(rows.back(), false);
       }
       for (const auto& name : filters) {
-        auto filter = make_filter(name);
+        auto filter = make_catalog_filter(name);
         filter->commit();
         if (!filter->missing_passes(loaded.frames.front()).empty()) continue;
         Progress progress(scene.name + " " + name, int(loaded.frames.size()));
@@ -139,7 +139,7 @@ Run add_demo(CLI::App& app) {
       "--spp", [a](const std::vector<int>& v) { a->spp = v; a->spp_given = true; },
       "input sample counts to denoise (default: 16 for stills, the lowest for sequences)")
       ->check(whole_number(1));
-  app.add_option("--filters", a->filters, "filters to run (default: all)");
+  app.add_option("--filters", a->filters, "filters to run (default: all, auto included)");
   add_threads_option(app, a->threads);
   app.add_flag("--json", a->json, "also print the table as JSON");
   return [a] { return run_demo(*a); };

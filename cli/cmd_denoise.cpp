@@ -149,7 +149,10 @@ Run add_denoise(CLI::App& app) {
   auto a = std::make_shared<DenoiseArgs>();
   app.add_option("input", a->input, "render or sequence pattern (shot_####.exr, shot_%04d.exr)")->required();
   app.add_option("-o,--output", a->output, "output EXR (a pattern for sequences)")->required();
-  app.add_option("-f,--filter", a->filter, "filter name (see `mcrecon filters`)")->required();
+  app.add_option("-f,--filter", a->filter,
+                 "filter name (see `mcrecon filters`); auto scores every filter the passes allow on sample tiles "
+                 "and runs the best, or keeps the input (--verbose names its choice and the scores)")
+      ->required();
   app.add_option("-s,--set", a->sets, "filter parameter KEY=VALUE (repeatable)")->allow_extra_args(false);
   app.add_option("--layer", a->layer, "view layer (default: the first with a colour pass)");
   app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)")->allow_extra_args(false);

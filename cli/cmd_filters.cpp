@@ -2,8 +2,8 @@
 #include <iostream>
 
 #include "commands.h"
-#include "filters/registry.h"
 #include "json_views.h"
+#include "pipeline/filter_catalog.h"
 
 namespace mcr::cli {
 
@@ -13,15 +13,15 @@ Run add_filters(CLI::App& app) {
   return [json_out] {
     if (*json_out) {
       nlohmann::json list = nlohmann::json::array();
-      for (const auto& name : filter_names()) list.push_back(to_json(filter_info(name)));
+      for (const auto& name : catalog_names()) list.push_back(to_json(catalog_info(name)));
       std::cout << nlohmann::json{{"filters", list}}.dump(2) << "\n";
       return 0;
     }
-    for (const auto& name : filter_names()) {
-      const FilterInfo& f = filter_info(name);
+    for (const auto& name : catalog_names()) {
+      const FilterInfo& f = catalog_info(name);
       std::cout << f.name << ": " << f.summary << (f.temporal ? " [temporal]" : "") << "\n";
       // Under the default settings (other settings may need more: `info` and errors say which).
-      auto filter = make_filter(name);
+      auto filter = make_catalog_filter(name);
       filter->commit();
       const PassNeeds need = filter->needs();
       std::cout << "  needs (defaults):";

@@ -1,9 +1,9 @@
 #include <iostream>
 
 #include "commands.h"
-#include "filters/registry.h"
 #include "io/frame_reader.h"
 #include "json_views.h"
+#include "pipeline/filter_catalog.h"
 #include "pipeline/reconstruction.h"
 
 namespace mcr::cli {
@@ -38,7 +38,7 @@ int run_info(const InfoArgs& a) {
   // Which filters can run with their default settings (Filter::needs()): the required
   // passes the file lacks, and the optional ones it has that they would use.
   nlohmann::json filters = nlohmann::json::array();
-  for (const auto& name : filter_names()) {
+  for (const auto& name : catalog_names()) {
     const auto f = make_committed_filter(name, {});
     nlohmann::json missing = nlohmann::json::array(), uses = nlohmann::json::array();
     for (Role r : f->missing_passes(frame)) missing.push_back(role_name(r));

@@ -27,7 +27,6 @@
 #include <memory>
 #include <mutex>
 
-#include "filters/registry.h"
 #include "history.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"

@@ -22,7 +22,7 @@ using KeyValues = std::vector<std::pair<std::string, std::string>>;
 
 struct Request {
   std::string source;   // the render to read ("x.exr" for "x.exr.mcrecon?...")
-  std::string filter;   // registry name
+  std::string filter;   // a catalog name: a registered filter or auto (pipeline/filter_catalog.h)
   KeyValues params;     // filter parameters, in the order given (last one wins)
   ReadOptions read;     // layer= and ROLE= pass overrides
   bool accumulate = false;       // accumulation stage before the filter (the CLI's --accumulate)

@@ -68,6 +68,8 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
                 else:
                     t = mc.Session(self.filter, params, accumulate=self.accumulate).denoise_file(src, out)
                     print(f"mcrecon: {out} ({t['total_ms']:.0f} ms)", flush=True)
+                    for note in t["notes"]:  # auto: its scores and choice
+                        self.report({"INFO"}, f"mcrecon: {note}")
             finally:
                 wm.progress_end()
         except mc.Error as e:

@@ -149,7 +149,8 @@ def register():
         ann[group_attr(info["name"])] = bpy.props.PointerProperty(type=cls)
     ann["filter"] = bpy.props.EnumProperty(
         name="Filter", items=[(i["name"], i["name"], i["summary"]) for i in infos],
-        default=infos[0]["name"], update=_on_filter_change,
+        # auto: a new user gets the filter that suits the render (and the passes it may read).
+        default="auto", update=_on_filter_change,
         description="mcrecon filter (Render properties show its parameters)")
     settings = type("MCRECON_PG_settings", (bpy.types.PropertyGroup,), {"__annotations__": ann})
     settings.__doc__ = "scene.mcrecon: mcrecon denoiser settings"

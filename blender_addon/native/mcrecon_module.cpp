@@ -16,10 +16,10 @@
 #include <utility>
 #include <vector>
 
-#include "filters/registry.h"
 #include "io/output_guard.h"
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
+#include "pipeline/filter_catalog.h"
 #include "util/error.h"
 #include "util/thread_count.h"
 
@@ -350,7 +350,9 @@ class Session {
       py::gil_scoped_release release;
       t = session_.run(input, output, r, wo, eo);
     }
-    return times_dict(t);
+    py::dict d = times_dict(t);
+    d["notes"] = notes();  // what auto chose and scored, unused settings: mcrecon.denoise_file keeps no Session
+    return d;
   }
 
  private:
@@ -400,17 +402,18 @@ PYBIND11_MODULE(mcrecon, m) {
     }
   });
 
-  m.def("filter_names", &mcr::filter_names, "Names of the registered filters, in registry order.");
+  m.def("filter_names", &mcr::catalog_names,
+        "Names of every filter, in registry order, then auto (which scores them and runs the best).");
   m.def(
       "filters",
       [] {
         py::list out;
-        for (const auto& n : mcr::filter_names()) out.append(info_to_dict(mcr::filter_info(n)));
+        for (const auto& n : mcr::catalog_names()) out.append(info_to_dict(mcr::catalog_info(n)));
         return out;
       },
       "Every filter with its full parameter table (same content as `mcrecon filters --json`).");
   m.def(
-      "filter_info", [](const std::string& name) { return info_to_dict(mcr::filter_info(name)); }, py::arg("name"),
+      "filter_info", [](const std::string& name) { return info_to_dict(mcr::catalog_info(name)); }, py::arg("name"),
       "One filter's description and parameter table; raises mcrecon.Error for an unknown name.");
 
   py::class_<Session>(m, "Session",
@@ -441,7 +444,8 @@ PYBIND11_MODULE(mcrecon, m) {
           "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32.")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
-           "Reads a render (multilayer EXR), filters it and writes output (temp + rename); returns stage timings. "
+           "Reads a render (multilayer EXR), filters it and writes output (temp + rename); returns stage timings "
+           "and the notes (as notes()). "
            "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}.");
 
   m.def(
@@ -473,7 +477,8 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
       py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
       py::arg("threads") = 0, py::arg("accumulate") = false,
-      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate).");
+      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate); returns "
+      "stage timings and the notes `--verbose` prints (filter='auto': the scores and the filter chosen).");
 
   m.def(
       "denoise_sequence",

@@ -97,6 +97,7 @@ def case_passes():
     import mcrecon_addon.native as native
     import mcrecon_addon.passes as passes
     mc = scene.mcrecon
+    result["default_filter"] = mc.filter  # a new scene's, before anything is chosen
     mc.enabled = True
     result["cycles_denoising"] = scene.cycles.use_denoising
     seen = {}
@@ -268,6 +269,7 @@ def case_install_zip():
 
 enable_addon()
 {"render_box": lambda: case_render("box"), "render_bilateral": lambda: case_render("bilateral"),
+ "render_auto": lambda: case_render("auto"),
  "passes": case_passes, "anim_bmfr": case_anim, "anim_accumulate": case_anim_accumulate,
  "errors": case_errors,
  "composite": case_composite, "install_zip": case_install_zip}[CASE]()

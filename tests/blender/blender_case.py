@@ -8,6 +8,7 @@ MCRECON_TEST_TMP. Exit 77 = skipped (ctest SKIP_RETURN_CODE).
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -117,6 +118,10 @@ def check_render(filter_name, box_radius=None):
     assert np.array_equal(got.view(np.uint32), want_px.view(np.uint32)), \
         f"the add-on's output differs from `mcrecon denoise -f {filter_name}` on the saved render " \
         f"(max |d| {np.abs(got - want_px).max()})"
+    if filter_name == "auto":  # its report reaches the console, naming a filter it ran
+        chose = re.findall(r"mcrecon: auto: chose (?:the )?(\S+)", log)
+        assert len(chose) == 1 and chose[0] in mcrecon.filter_names() + ["input"], log[-3000:]
+        print(f"auto chose {chose[0]}")
     e_noisy, e_den = relmse(rgb(noisy), rgb(ref)), relmse(rgb(den), rgb(ref))
     print(f"{filter_name}: relMSE noisy {e_noisy:.5f}, denoised {e_den:.5f} "
           f"(render 16 spp {r['noisy_seconds']:.1f} s, reference 256 spp {r['ref_seconds']:.1f} s)")
@@ -164,6 +169,12 @@ def check_passes():
         # bilateral's defaults: use_depth=off, so no depth pass (needs() drops it).
         assert t["use_pass_normal"] and t["use_pass_position"] and not t["use_pass_z"] \
             and t["cycles.denoising_store_passes"] and not t["use_pass_vector"], t
+    # auto, the default: the feature passes its candidates may read (Blender renders no variance,
+    # sample count or second hit), not the motion vectors no still filter reads.
+    assert r["default_filter"] == "auto", r["default_filter"]
+    t = r["filters"]["auto"]["toggles"]
+    assert t["use_pass_normal"] and t["use_pass_position"] and t["use_pass_z"] \
+        and t["cycles.denoising_store_passes"] and not t["use_pass_vector"], t
     assert not any(r["after_operator_box"].values())
     for name, drawn in r["panel"].items():
         params = [p["name"] for p in mcrecon.filter_info(name)["parameters"]]
@@ -279,7 +290,7 @@ def check_install_zip():
     print(f"installed from the zip into {scripts}; native module {os.path.basename(r['native_file'])}")
 
 
-{"render_box": lambda: check_render("box"),
+{"render_box": lambda: check_render("box"), "render_auto": lambda: check_render("auto"),
  "render_bilateral": lambda: check_render("bilateral", box_radius=bilateral_radius()),
  "passes": check_passes, "anim_bmfr": check_anim, "anim_accumulate": check_anim_accumulate,
  "errors": check_errors,

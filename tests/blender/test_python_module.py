@@ -7,11 +7,14 @@
   the anim sample matches `mcrecon denoise --accumulate` bit for bit (and differs from the plain run);
 - needs() agrees with `mcrecon info --json` (which filters can run, which passes they use) and
   changes with the settings; Session.notes() holds the unused setting `--verbose` prints;
+- filter "auto" is listed; denoise_file returns its notes (what it chose, as `--verbose` prints) and
+  its output is the chosen filter's bit for bit;
 - errors raise mcrecon.Error naming the parameter / filter / pass, with .kind.
 Environment: MCRECON_BIN, MCRECON_SOURCE_DIR, MCRECON_PYTHON_DIR (the module's folder).
 """
 import json
 import os
+import re
 import subprocess
 import sys
 import tempfile
@@ -91,6 +94,42 @@ def test_arrays_match_cli(tmp):
         s = mcrecon.Session(filt, params)
         assert np.array_equal(s.denoise(**{k: passes[k] for k in used}), ref)
         print(f"{filt}: arrays, denoise_file and Session match `mcrecon denoise` bit for bit")
+
+
+def test_auto_reports_its_choice(tmp):
+    """filter='auto' in every entry point: listed, its table as the CLI's, and denoise_file's notes
+    name the filter it ran; the output is that filter's, bit for bit (the oracle for the report)."""
+    assert "auto" in mcrecon.filter_names() and mcrecon.filter_names()[-1] == "auto", mcrecon.filter_names()
+    info = mcrecon.filter_info("auto")
+    assert {p["name"] for p in info["parameters"]} == {"sample_fraction", "min_gain"}, info["parameters"]
+    assert info in mcrecon.filters()
+    out = os.path.join(tmp, "auto_py.exr")
+    t = mcrecon.denoise_file(ROOM, out, "auto")
+    assert set(t) >= {"read_ms", "filter_ms", "write_ms", "total_ms", "notes"}, t
+    chosen = [n[len("auto: chose "):].split()[0] for n in t["notes"] if n.startswith("auto: chose ")]
+    assert len(chosen) == 1 and any(n.startswith("auto: estimated relMSE") for n in t["notes"]), t["notes"]
+    assert chosen[0] in mcrecon.filter_names() and chosen[0] != "auto", t["notes"]
+    # The same notes as `mcrecon denoise --verbose` prints, and as Session.notes() after a run.
+    err = cli("denoise", ROOM, "-o", os.path.join(tmp, "auto_cli.exr"), "-f", "auto", "--verbose", stderr=True)
+    prefix = "mcrecon: " + ROOM + ": "
+    assert [l[len(prefix):] for l in err.splitlines() if l.startswith(prefix)] == t["notes"], (err, t["notes"])
+    s = mcrecon.Session("auto")
+    assert s.denoise_file(ROOM, os.path.join(tmp, "auto_session.exr"))["notes"] == s.notes() == t["notes"]
+    want = os.path.join(tmp, "auto_chosen.exr")
+    mcrecon.denoise_file(ROOM, want, chosen[0])
+    assert np.array_equal(read_channels(out)[1], read_channels(want)[1]), f"auto's output is not {chosen[0]}'s"
+    # Arrays: colour alone (the filters that need a feature pass are skipped, and said so).
+    names, px = read_channels(ROOM)
+    colour = group(names, px, "ViewLayer.Combined", "RGB")
+    s = mcrecon.Session("auto")
+    got = s.denoise(colour)
+    assert got.shape == colour.shape and np.isfinite(got).all()
+    assert len([n for n in s.notes() if n.startswith("auto: chose ")]) == 1, s.notes()
+    lacking = [f["name"] for f in mcrecon.filters() if not f["temporal"] and f["name"] != "auto"
+               and set(mcrecon.needs(f["name"])["required"]) - {"colour"}]
+    skipped = [n for n in s.notes() if n.startswith("auto: candidates skipped: ")]
+    assert [re.findall(r"(\w+) \(no ", n) for n in skipped] == ([lacking] if lacking else []), (lacking, s.notes())
+    print(f"auto: chose {chosen[0]} on the room sample; notes as `--verbose`; output is {chosen[0]}'s bit for bit")
 
 
 def frame_path(pattern, f):
@@ -276,6 +315,7 @@ if __name__ == "__main__":
     with tempfile.TemporaryDirectory(prefix="mcrecon_py_") as tmp:
         test_filters_match_cli()
         test_arrays_match_cli(tmp)
+        test_auto_reports_its_choice(tmp)
         test_accumulate_matches_cli(tmp)
         test_needs_match_info_and_settings(tmp)
         test_notes_hold_unused_settings(tmp)

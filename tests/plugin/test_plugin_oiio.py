@@ -8,7 +8,7 @@ Covered: every non-temporal filter through the `?key=value` name, --iconfig and 
 plugin (-o:fileformatname=mcrecon) on the room sample; temporal filters over an
 `oiiotool --frames 1-16` run on the anim sample (skipped when none is registered); accumulate
 (`mcrecon denoise --accumulate`) over frames 1-4 of the anim sample in all three styles; the
-notes (an unused setting) as the mcreconNotes attribute; no hang on a corrupt EXR; a header
+notes (an unused setting; auto's scores and choice) as the mcreconNotes attribute; no hang on a corrupt EXR; a header
 claiming more than its file holds refused before anything opens it;
 --list-formats; errors named as the CLI names them, with a non-zero exit; a read through
 OpenImageIO's Python module.
@@ -364,11 +364,16 @@ class TestAccumulate(PluginTestBase):
 
 
 class TestNotes(PluginTestBase):
+    def cli_notes(self, *args):
+        """(unused settings, the run's notes) as `mcrecon denoise ROOM --verbose` prints them."""
+        err = tu.run_cli("denoise", ROOM, "-o", self.path("cli.exr"), *args, "--verbose").stderr
+        unused = [l[len("mcrecon: note: "):] for l in err.splitlines() if l.startswith("mcrecon: note: ")]
+        prefix = "mcrecon: " + ROOM + ": "
+        return unused, [l[len(prefix):] for l in err.splitlines() if l.startswith(prefix)]
+
     def test_unused_setting_is_the_mcrecon_notes_attribute(self):
-        cli = tu.run_cli("denoise", ROOM, "-o", self.path("cli.exr"), "-f", "box", "--set", "firefly_radius=5",
-                         "--verbose")
-        notes = [l[len("mcrecon: note: "):] for l in cli.stderr.splitlines() if l.startswith("mcrecon: note: ")]
-        self.assertEqual(notes, ["firefly_radius has no effect with firefly_k=0"], cli.stderr)
+        notes, run = self.cli_notes("-f", "box", "--set", "firefly_radius=5")
+        self.assertEqual(notes, ["firefly_radius has no effect with firefly_k=0"])
         name = ROOM + ".mcrecon?filter=box&firefly_radius=5"
         # 1. the input plugin's spec, before any pixel is read
         oiio.attribute("plugin_searchpath", plugin_dir())
@@ -378,19 +383,51 @@ class TestNotes(PluginTestBase):
             self.assertEqual(inp.spec().getattribute("mcreconNotes"), notes[0])
         finally:
             inp.close()
-        # 2. a file written from the input plugin's read carries it
+        # 2. a file written from the input plugin's read carries it (oiiotool copies the header
+        # at open, before the filter runs: the run's own notes are not there)
         read = self.path("read.exr")
         check_ok(oiiotool(name, "-o", read))
         self.assertEqual(header_attribute(read, "mcreconNotes"), notes[0])
-        # 3. the output plugin's file
+        # 3. the output plugin's file: the unused setting first, then the run's notes
         out = self.path("out.exr")
         check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "--attrib:type=int", "mcrecon:firefly_radius",
                           "5", "-o:fileformatname=mcrecon", out))
-        self.assertEqual(header_attribute(out, "mcreconNotes"), notes[0])
-        # Without the setting there is nothing to say.
+        self.assertEqual(header_attribute(out, "mcreconNotes"), "; ".join(notes + run))
+        # Without the setting only the run's notes are said.
+        quiet_notes, quiet_run = self.cli_notes("-f", "box")
+        self.assertEqual(quiet_notes, [])
         quiet = self.path("quiet.exr")
         check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "-o:fileformatname=mcrecon", quiet))
-        self.assertIsNone(header_attribute(quiet, "mcreconNotes"))
+        self.assertEqual(header_attribute(quiet, "mcreconNotes"), "; ".join(quiet_run) or None)
+
+    def test_auto_reports_its_choice(self):
+        # auto's notes (scores, the filter chosen) are mcreconNotes, as `--verbose` prints them,
+        # and the pixels are the chosen filter's as the CLI runs it.
+        self.assertIn("auto", [f["name"] for f in self.filters])
+        unused, run = self.cli_notes("-f", "auto")
+        self.assertEqual(unused, [])
+        chosen = [n[len("auto: chose "):].split()[0] for n in run if n.startswith("auto: chose ")]
+        self.assertEqual(len(chosen), 1, run)
+        want = self.path("chosen.exr")
+        tu.run_cli("denoise", ROOM, "-o", want, "-f", chosen[0])
+        # the output plugin: its header
+        out = self.path("out.exr")
+        check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "auto", "-o:fileformatname=mcrecon", out))
+        self.assertEqual(header_attribute(out, "mcreconFilter"), "auto")
+        self.assertEqual(header_attribute(out, "mcreconNotes"), "; ".join(run))
+        assert_same_pixels(self, out, want, "--attrib mcrecon:filter auto (auto chose %s)" % chosen[0])
+        # the input plugin: the spec after the first read holds them (the filter runs there)
+        read = self.path("read.exr")
+        check_ok(oiiotool(ROOM + ".mcrecon?filter=auto", "-o", read))
+        assert_same_pixels(self, read, want, "?filter=auto (auto chose %s)" % chosen[0])
+        oiio.attribute("plugin_searchpath", plugin_dir())
+        inp = oiio.ImageInput.open(ROOM + ".mcrecon?filter=auto")
+        self.assertIsNotNone(inp, oiio.geterror())
+        try:
+            self.assertIsNotNone(inp.read_image(0, 0, 0, 4, "float"), inp.geterror())
+            self.assertEqual(inp.spec().getattribute("mcreconNotes"), "; ".join(run))
+        finally:
+            inp.close()
 
 
 class TestErrors(PluginTestBase):

@@ -1,0 +1,116 @@
+"""Filter `auto` through the CLI: listed by `filters` (text and --json, with its parameter table)
+and `info`, and `denoise -f auto --verbose` names what it chose. The oracle for the choice being
+the one that ran: the output equals `denoise -f CHOSEN` of the same file bit for bit, or the input
+itself when auto kept it.
+
+Run by ctest as `/usr/bin/python3 tests/python/test_cli_auto.py` with MCRECON_BIN and
+MCRECON_SOURCE_DIR.
+"""
+import os
+import re
+import shutil
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import mcrecon_testutil as tu  # noqa: E402
+
+RGBA = ["R", "G", "B", "A"]
+ROOM = os.path.join(tu.source_dir(), "samples", "data", "room", "room_16spp.exr")
+
+
+def same_bits(a, b):
+    a, b = np.ascontiguousarray(a, np.float32), np.ascontiguousarray(b, np.float32)
+    return a.shape == b.shape and np.array_equal(a.view(np.uint32), b.view(np.uint32))
+
+
+def chosen_in(stderr):
+    """The filter `--verbose` says auto chose ("input" when it kept the input)."""
+    m = re.findall(r"auto: chose (?:the )?(\S+)", stderr)
+    assert len(m) == 1, "expected one 'auto: chose ...' note:\n" + stderr
+    return m[0]
+
+
+class AutoCliTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="mcrecon_auto_")
+        self.addCleanup(shutil.rmtree, self.tmp, ignore_errors=True)
+
+    def path(self, name):
+        return os.path.join(self.tmp, name)
+
+    def colour_only(self, name, rgb):
+        h, w = rgb.shape[:2]
+        p = self.path(name)
+        tu.write_exr(p, np.concatenate([rgb, np.ones((h, w, 1))], axis=-1), RGBA)
+        return p
+
+    def test_filters_lists_auto_with_its_parameters(self):
+        filters = tu.run_cli_json("filters", "--json")["filters"]
+        names = [f["name"] for f in filters]
+        self.assertIn("auto", names)
+        auto = filters[names.index("auto")]
+        self.assertEqual(auto["required_passes"], ["colour"])
+        self.assertFalse(auto["temporal"])
+        params = {p["name"]: p for p in auto["parameters"]}
+        self.assertEqual(set(params), {"sample_fraction", "min_gain"})
+        for p in params.values():
+            self.assertEqual(p["type"], "float")
+            self.assertLessEqual(p["min"], p["default"])
+            self.assertLessEqual(p["default"], p["max"])
+        text = tu.run_cli("filters").stdout
+        self.assertRegex(text, r"(?m)^auto: ")
+        self.assertIn("--set sample_fraction", text)
+
+    def test_info_says_auto_can_run_on_colour_alone(self):
+        rng = np.random.default_rng(1)
+        only = self.colour_only("only.exr", rng.random((12, 16, 3)))
+        for path, uses in ((only, []), (ROOM, None)):
+            entry = {f["name"]: f for f in tu.run_cli_json("info", "--json", path)["filters"]}["auto"]
+            self.assertTrue(entry["can_run"], entry)
+            self.assertEqual(entry["missing"], [])
+            if uses is not None:
+                self.assertEqual(entry["uses"], uses)
+        self.assertIn("auto: can run", tu.run_cli("info", only).stdout)
+
+    def test_denoise_auto_runs_the_filter_it_names(self):
+        out = self.path("auto.exr")
+        err = tu.run_cli("denoise", ROOM, "-o", out, "-f", "auto", "--verbose").stderr
+        chosen = chosen_in(err)
+        self.assertIn("auto: estimated relMSE", err)
+        names = [f["name"] for f in tu.run_cli_json("filters", "--json")["filters"]]
+        self.assertIn(chosen, [n for n in names if n != "auto"] + ["input"])
+        # On this 16 spp render some filter is estimated to help (the sample's reference says so too).
+        self.assertNotEqual(chosen, "input", err)
+        want = self.path("chosen.exr")
+        tu.run_cli("denoise", ROOM, "-o", want, "-f", chosen)
+        self.assertTrue(same_bits(tu.read_channels(out, RGBA), tu.read_channels(want, RGBA)),
+                        "auto's output is not `denoise -f %s` of the same file" % chosen)
+
+    def test_denoise_auto_on_colour_only_files(self):
+        h, w = 64, 80
+        y, x = np.mgrid[0:h, 0:w]
+        clean = np.stack([0.2 + 0.6 * x / w, 0.3 + 0.4 * y / h, np.full((h, w), 0.5)], axis=-1)
+        noise = np.random.default_rng(3).gamma(4.0, 0.25, (h, w, 1))  # mean 1: 1/sqrt(4) relative noise
+        # A noisy render: a filter is run and named, and the output is that filter's.
+        noisy = self.colour_only("noisy.exr", clean * noise)
+        out = self.path("noisy_auto.exr")
+        err = tu.run_cli("denoise", noisy, "-o", out, "-f", "auto", "-v").stderr
+        chosen = chosen_in(err)
+        self.assertNotEqual(chosen, "input", err)
+        want = self.path("noisy_chosen.exr")
+        tu.run_cli("denoise", noisy, "-o", want, "-f", chosen)
+        self.assertTrue(same_bits(tu.read_channels(out, RGBA), tu.read_channels(want, RGBA)))
+        # A render without noise: the input is kept as it is, and said so.
+        flat = self.colour_only("clean.exr", clean)
+        out = self.path("clean_auto.exr")
+        err = tu.run_cli("denoise", flat, "-o", out, "-f", "auto", "-v").stderr
+        self.assertEqual(chosen_in(err), "input", err)
+        self.assertTrue(same_bits(tu.read_channels(out, RGBA), tu.read_channels(flat, RGBA)))
+
+
+if __name__ == "__main__":
+    unittest.main()
