@@ -43,7 +43,7 @@ inline void check_pair(const Image& a, const Image& b, const char* what, const c
 template <class Fn>
 void parallel_blocks(int count, int block, int nthreads, const Fn& fn) {
   const int nblocks = (count + block - 1) / block;
-  tbb::task_arena arena(arena_threads(nthreads));
+  tbb::task_arena& arena = shared_arena(nthreads);
   arena.execute([&] {
     tbb::parallel_for(
         tbb::blocked_range<int>(0, nblocks, 1),

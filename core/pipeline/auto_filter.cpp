@@ -262,7 +262,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   std::string table;
   for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + fixed(s.relmse, 3);
   note("auto: estimated relMSE on " + std::to_string(tiles.size()) + (tiles.size() == 1 ? " sample (the whole region)" : " tiles") +
-       ": " + table);
+       " (SURE: only the order counts; below 0 where the noise estimate runs high): " + table);
 
   // 3. The best, unless it is not estimated to beat the input by min_gain.
   const double input_score = in_sum / n;
@@ -292,7 +292,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       eo.nthreads = nthreads;
       out = f->execute(frame, eo);
       note("auto: chose " + chosen_ + " with its defaults");
-      for (const std::string& m : f->notes()) note(chosen_ + ": " + m);
+      for (const std::string& m : f->notes()) note(m.rfind(chosen_ + ":", 0) == 0 ? m : chosen_ + ": " + m);
       return;
     }
 }

@@ -436,7 +436,7 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   const int nblocks = nbx * nby;
   FitJob job{w, h, B, ox, oy, nbx, R, M, pch, nch, lay, eps, seed, frame_index_, clamp_max, &pos, &nrm, alb, dep, &illum,
              valid.data(), &fitted};
-  tbb::task_arena arena(arena_threads(nthreads));
+  tbb::task_arena& arena = shared_arena(nthreads);
   arena.execute([&] {
     tbb::parallel_for(tbb::blocked_range<int>(0, nblocks, 1), [&](const tbb::blocked_range<int>& range) {
       // Per thread, kept from frame to frame (a fresh scratch per frame was ~200 KB of
