@@ -19,6 +19,7 @@ namespace {
 
 struct DenoiseArgs {
   std::string input, output, filter, layer, frames, region, compression = "zip";
+  std::string half;  // the other half buffer (a pattern for sequences)
   std::vector<std::string> sets, passes;
   bool keep_passes = false, timings = false, verbose = false, resume = false;
   bool accumulate = false;  // the accumulation stage before the filter
@@ -65,7 +66,10 @@ int run_denoise(const DenoiseArgs& a) {
 
   // Frame list: a single file, or a pattern with --frames.
   std::vector<std::pair<std::string, std::string>> jobs;
+  std::vector<std::string> halves;  // per job: the second half buffer, when --half is given
   const bool seq = is_sequence_pattern(a.input);
+  if (!a.half.empty() && seq != is_sequence_pattern(a.half))
+    throw Error(Errc::InvalidArgument, "--half '" + a.half + "' must be a pattern exactly when the input '" + a.input + "' is");
   if (seq) {
     if (a.frames.empty()) throw Error(Errc::InvalidArgument, "input '" + a.input + "' is a sequence pattern: give --frames A-B");
     if (!is_sequence_pattern(a.output))
@@ -76,10 +80,12 @@ int run_denoise(const DenoiseArgs& a) {
       std::error_code ec;
       if (!std::filesystem::exists(in, ec)) throw Error(Errc::FileNotFound, "cannot read '" + in + "': no such file");
       jobs.emplace_back(std::move(in), sequence_path(a.output, int(f)));
+      if (!a.half.empty()) halves.push_back(sequence_path(a.half, int(f)));
     }
   } else {
     if (!a.frames.empty()) throw Error(Errc::InvalidArgument, "--frames needs a sequence pattern (#### or %04d) as input");
     jobs.emplace_back(a.input, a.output);
+    if (!a.half.empty()) halves.push_back(a.half);
   }
   // Check every frame before the first is filtered: a missing frame 90 of 100
   // or an output over an input should not cost a whole run.
@@ -90,6 +96,14 @@ int run_denoise(const DenoiseArgs& a) {
     inputs.push_back(j.first);
   }
   for (std::string& f : loose_pass_files(ro)) inputs.push_back(std::move(f));  // --pass normal=n.exr
+  for (const std::string& h : halves) {
+    std::error_code ec;
+    if (!std::filesystem::exists(h, ec)) throw Error(Errc::FileNotFound, "cannot read --half '" + h + "': no such file");
+    const std::string& own = jobs[std::size_t(&h - halves.data())].first;
+    if (std::filesystem::equivalent(h, own, ec))
+      throw Error(Errc::InvalidArgument, "--half '" + h + "' is the input itself: give the other half buffer");
+    inputs.push_back(h);
+  }
   std::vector<std::string> outputs;
   for (const auto& j : jobs) outputs.push_back(j.second);
   if (seq) check_sequence_outputs(a.output, parse_frame_range(a.frames), inputs);  // every frame its own file
@@ -125,7 +139,9 @@ int run_denoise(const DenoiseArgs& a) {
       continue;
     }
     // Temporal filters replay finished frames without writing, to warm up history.
-    const StageTimes t = session.run(in, done ? std::string() : out, ro, wo, eo);
+    ReadOptions frame_ro = ro;
+    if (!halves.empty()) frame_ro.second_half = halves[i];
+    const StageTimes t = session.run(in, done ? std::string() : out, frame_ro, wo, eo);
     sum.read_ms += t.read_ms;
     sum.filter_ms += t.filter_ms;
     sum.write_ms += t.write_ms;
@@ -157,6 +173,9 @@ Run add_denoise(CLI::App& app) {
   app.add_option("--layer", a->layer, "view layer (default: the first with a colour pass)");
   app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)")->allow_extra_args(false);
   app.add_option("--frames", a->frames, "frame range A-B for a sequence pattern");
+  app.add_option("--half", a->half,
+                 "the other half buffer of the input (the same render's samples split in two, e.g. Blender's "
+                 "sample_offset): filter their mean, with the noise from their difference (a pattern for sequences)");
   app.add_option("--region", a->region, "only filter X0,Y0,X1,Y1 (end exclusive); the rest keeps the input");
   add_threads_option(app, a->threads);
   app.add_option("--compression", a->compression, "EXR compression of the output (zip, piz, none, ...)");
