@@ -56,7 +56,7 @@ class AutoCliTest(unittest.TestCase):
         self.assertEqual(auto["required_passes"], ["colour"])
         self.assertFalse(auto["temporal"])
         params = {p["name"]: p for p in auto["parameters"]}
-        self.assertEqual(set(params), {"sample_fraction", "min_gain"})
+        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain"})
         for p in params.values():
             self.assertEqual(p["type"], "float")
             self.assertLessEqual(p["min"], p["default"])
