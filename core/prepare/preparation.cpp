@@ -89,9 +89,15 @@ Frame& own_frame(const Frame& frame, Prepared& out) {
 
 void preparation_needs(const ParamSet& params, const PrepSteps& steps, std::vector<Role>& required,
                        std::vector<std::string>& why, std::vector<Role>& optional) {
+  // A filter whose default is demodulate=true (guided) uses the albedo when present;
+  // only a demodulate=true the user gave makes it required.
   if (steps.demodulate && params.get_bool("demodulate")) {
-    required.push_back(Role::Albedo);
-    why.push_back("demodulate=true");
+    if (params.was_set("demodulate")) {
+      required.push_back(Role::Albedo);
+      why.push_back("demodulate=true");
+    } else {
+      optional.push_back(Role::Albedo);
+    }
   }
   if (steps.albedo_prefilter && params.get_float("albedo_prefilter") > 0) {
     for (Role r : {Role::Albedo, Role::Normal, Role::Position}) optional.push_back(r);
@@ -180,9 +186,14 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   // Albedo demodulation: filter the illumination, not the texture.
   if (steps.demodulate && params.get_bool("demodulate")) {
     const Pass* a = out.frame->find(Role::Albedo);
-    if (!a) throw Error(Errc::MissingPass, "demodulate=true needs the albedo pass, absent in '" + frame.path + "'");
-    out.divisor = Image(w, h, 3);
-    demodulate(a->image, float(params.get_float("albedo_floor")), demod_region, nthreads, out.divisor, out.colour);
+    if (a) {
+      out.divisor = Image(w, h, 3);
+      demodulate(a->image, float(params.get_float("albedo_floor")), demod_region, nthreads, out.divisor, out.colour);
+    } else if (params.was_set("demodulate")) {
+      throw Error(Errc::MissingPass, "demodulate=true needs the albedo pass, absent in '" + frame.path + "'");
+    } else {
+      out.notes.push_back("demodulation skipped: no albedo pass in '" + frame.path + "' (demodulate is on by default)");
+    }
   }
   // Firefly suppression, after demodulation: on the illumination a texture edge is not an
   // outlier, and a firefly stands out of its window more clearly (glossy: 0.0099 -> 0.0090).

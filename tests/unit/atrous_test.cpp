@@ -39,6 +39,7 @@ std::vector<double> kernel_1d(int kg) {
 // renormalised at the borders; non-finite policy as in the filter's info.
 Image reference(const Frame& frame, const Params& given) {
   AtrousFilter probe;
+  testutil::with_kernel_colour_weight(probe);
   for (const auto& [k, v] : given) probe.set(k, v);
   const ParamSet& ps = probe.params();
   const int w = frame.width, h = frame.height;
@@ -296,6 +297,7 @@ TEST(AtrousFilterTest, ScratchReuseAcrossFrames) {
   // The same filter object on frames of different sizes and passes gives what a fresh one gives.
   AtrousFilter f;
   testutil::without_step_back(f);
+  testutil::with_kernel_colour_weight(f);
   for (const auto& [k, v] : mild()) f.set(k, v);
   f.set("use_depth", std::string("auto"));
   f.commit();
@@ -312,6 +314,14 @@ TEST(AtrousFilterTest, ScratchReuseAcrossFrames) {
   const Image full = run_on(c, with(mild(), {{"use_depth", std::string("auto")}})).out;
   for (int y = roi.y0; y < roi.y1; ++y)
     for (int x = roi.x0; x < roi.x1; ++x) ASSERT_EQ(part.at(x, y, 1), full.at(x, y, 1)) << x << "," << y;
+}
+
+TEST(AtrousFilterTest, DefaultsFollowTheNoise) {
+  AtrousFilter f;
+  EXPECT_EQ(f.params().get_enum("colour_weight"), "noise");
+  EXPECT_EQ(f.params().get_float("colour_sigma"), 4.0);
+  EXPECT_EQ(f.params().get_float("albedo_sigma"), 0.05);
+  expect_defaults_follow_the_noise<AtrousFilter>();
 }
 
 }  // namespace

@@ -14,6 +14,7 @@ namespace mcr::testutil {
 
 inline Image bilateral_reference(const Frame& frame, const Params& given) {
   BilateralFilter probe;
+  with_kernel_colour_weight(probe);
   for (const auto& [k, v] : given) probe.set(k, v);
   const ParamSet& ps = probe.params();
   const int w = frame.width, h = frame.height;

@@ -243,5 +243,13 @@ TEST(BilateralFilterTest, TableAndPolicy) {
   EXPECT_NE(info.nonfinite_policy.find("weight 0"), std::string::npos);
 }
 
+TEST(BilateralFilterTest, DefaultsFollowTheNoise) {
+  BilateralFilter f;
+  EXPECT_EQ(f.params().get_enum("colour_weight"), "noise");
+  EXPECT_EQ(f.params().get_float("colour_sigma"), 4.0);
+  EXPECT_EQ(f.params().get_float("albedo_sigma"), 0.05);
+  expect_defaults_follow_the_noise<BilateralFilter>();
+}
+
 }  // namespace
 }  // namespace mcr

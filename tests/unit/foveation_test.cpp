@@ -151,6 +151,7 @@ Image run(const std::string& filter, const Frame& frame, const Params& params, i
 }
 
 // Inner set, outer set and the parameters they differ in, per filter.
+// Colour sigmas in radiance units (colour_weight=absolute; the defaults are noise-relative).
 struct Case {
   std::string filter;
   Params inner, outer;  // plain (non-foveated) parameter sets
@@ -161,15 +162,17 @@ std::vector<Case> cases() {
   return {
       {"gaussian", {{"sigma", 0.4}}, {{"sigma", 1.3}}, 4},
       {"bilateral",
-       {{"spatial_sigma", 0.7}, {"colour_sigma", 0.2}, {"normal_sigma", 0.3}, {"position_sigma", 1.0},
+       {{"colour_weight", std::string("absolute")}, {"spatial_sigma", 0.7}, {"colour_sigma", 0.2}, {"normal_sigma", 0.3}, {"position_sigma", 1.0},
         {"albedo_sigma", 0.3}},
-       {{"spatial_sigma", 1.6}, {"colour_sigma", 1.5}, {"normal_sigma", 2.0}, {"position_sigma", 5.0},
+       {{"colour_weight", std::string("absolute")}, {"spatial_sigma", 1.6}, {"colour_sigma", 1.5}, {"normal_sigma", 2.0}, {"position_sigma", 5.0},
         {"albedo_sigma", 2.0}},
        5},
       {"atrous",
-       {{"kernel_size", std::int64_t(3)}, {"iterations", std::int64_t(2)}, {"colour_sigma", 0.1},
+       {{"colour_weight", std::string("absolute")}, {"kernel_size", std::int64_t(3)}, {"iterations", std::int64_t(2)},
+        {"colour_sigma", 0.1},
         {"normal_sigma", 0.3}, {"position_sigma", 0.2}, {"albedo_sigma", 0.2}},
-       {{"kernel_size", std::int64_t(3)}, {"iterations", std::int64_t(2)}, {"colour_sigma", 3.0},
+       {{"colour_weight", std::string("absolute")}, {"kernel_size", std::int64_t(3)}, {"iterations", std::int64_t(2)},
+        {"colour_sigma", 3.0},
         {"normal_sigma", 3.0}, {"position_sigma", 5.0}, {"albedo_sigma", 2.0}},
        3},
   };
@@ -241,8 +244,10 @@ TEST(FoveationTest, MidwayIsTheLinearInterpolation) {
   const Params fov = {{"foveated", true},           {"gaze_x", 40.5 / 80},       {"gaze_y", 30.5 / 60},
                       {"inner_radius", 0.1},        {"outer_radius", 0.3},       {"spatial_sigma", 0.5},
                       {"spatial_sigma_outer", 2.5}, {"colour_sigma", 0.2},       {"colour_sigma_outer", 1.0},
-                      {"normal_sigma", 0.3},        {"normal_sigma_outer", 0.9}, {"radius", std::int64_t(8)}};
-  const Params mid = {{"spatial_sigma", 1.5}, {"colour_sigma", 0.6}, {"normal_sigma", 0.6}, {"radius", std::int64_t(8)}};
+                      {"normal_sigma", 0.3},        {"normal_sigma_outer", 0.9}, {"radius", std::int64_t(8)},
+                      {"colour_weight", std::string("absolute")}, {"albedo_sigma", 0.1}};
+  const Params mid = {{"spatial_sigma", 1.5}, {"colour_sigma", 0.6}, {"normal_sigma", 0.6}, {"radius", std::int64_t(8)},
+                      {"colour_weight", std::string("absolute")}, {"albedo_sigma", 0.1}};
   const Image a = run("bilateral", frame, fov), b = run("bilateral", frame, mid);
   // Pixels at distance 20 (t = 0.5) in four directions.
   for (auto [x, y] : {std::pair{60, 30}, std::pair{20, 30}, std::pair{40, 10}, std::pair{52, 46}})

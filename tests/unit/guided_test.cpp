@@ -87,10 +87,16 @@ struct Result : testutil::Result {
   GuidedStats stats;
 };
 
+// The kernel tests fix what the defaults choose from the frame (guide, epsilon from the
+// noise, demodulation), so the oracle below sees exactly what it models; the defaults
+// have tests of their own (DefaultsFollowTheNoise and after).
+const Params kKernelDefaults = {{"guide", std::string("normal_depth")}, {"epsilon", 0.01}, {"demodulate", false}};
+
 Result run_guided(const Frame& frame, const Params& params, int nthreads = 1, Roi roi = {}) {
   GuidedFilter f;
   Result r;
-  static_cast<testutil::Result&>(r) = testutil::run_filter(f, frame, params, nthreads, roi);
+  static_cast<testutil::Result&>(r) =
+      testutil::run_filter(f, frame, testutil::with(kKernelDefaults, params), nthreads, roi);
   r.stats = f.stats();
   return r;
 }
@@ -118,6 +124,7 @@ std::vector<GuideGroup> guide_groups(const std::string& guide) {
   if (guide == "normal_depth_albedo") return {n, d, a};
   if (guide == "luminance") return {{Role::Colour, true, 1, false}};
   if (guide == "colour") return {{Role::Colour, false, 3, false}};
+  if (guide == "normal_depth_colour") return {n, d, {Role::Colour, false, 3, false}};
   ADD_FAILURE() << "unknown guide " << guide;
   return {};
 }
@@ -287,7 +294,7 @@ TEST(GuidedFilterTest, MatchesOracleNormalDepth) {
 TEST(GuidedFilterTest, MatchesOracleEveryGuide) {
   const Frame f = frame_of(random_passes(11, 8, 2));
   for (const char* g : {"normal", "depth", "position", "normal_position", "albedo", "normal_albedo",
-                        "normal_depth_albedo", "luminance", "colour"})
+                        "normal_depth_albedo", "luminance", "colour", "normal_depth_colour"})
     for (int r : {1, 3}) {
       const Result res = run_guided(f, {{"guide", std::string(g)}, {"radius", std::int64_t(r)}});
       expect_close(res.out, oracle(f, g, r, 0.01), 1e-4, std::string(g) + " r=" + std::to_string(r));
@@ -778,10 +785,9 @@ TEST(GuidedFilterTest, ParameterTableAndRegistry) {
   EXPECT_EQ(info.required, std::vector<Role>{Role::Colour});
   for (const char* p : {"guide", "radius", "epsilon", "clamp", "demodulate", "albedo_floor", "holes"})
     EXPECT_TRUE(f->params().has(p)) << p;
-  EXPECT_EQ(f->params().get_enum("guide"), "normal_depth");
-  EXPECT_EQ(f->params().get_float("epsilon"), 0.01);
   EXPECT_THROW(f->set("radius", std::int64_t(0)), Error);
-  EXPECT_THROW(f->set("epsilon", 0.0), Error);
+  EXPECT_THROW(f->set("epsilon", -1e-9), Error);
+  EXPECT_THROW(f->set("epsilon_scale", 0.0), Error);
   EXPECT_THROW(f->set_text("guide", "rgb"), Error);
 }
 
@@ -798,6 +804,127 @@ TEST(GuidedFilterTest, GuideNormalisationIsDocumented) {
   EXPECT_NEAR(res.stats.guide_mean[3], m, 1e-9 * m);
   EXPECT_NEAR(res.stats.guide_scale[3], std::sqrt(v / ps.depth.storage().size()), 1e-9 * m);
   for (int j = 0; j < 3; ++j) EXPECT_EQ(res.stats.guide_scale[j], 1.0);  // unit normals spread < 1
+}
+
+// ---------------------------------------------------------------------------
+// Defaults: the guide with the colour, demodulation, epsilon from the noise
+
+Result run_with_defaults(const Frame& frame, const Params& params) {
+  GuidedFilter f;
+  Result r;
+  static_cast<testutil::Result&>(r) = testutil::run_filter(f, frame, params, 1);
+  r.stats = f.stats();
+  return r;
+}
+
+// A flat grey frame (luminance 1) with white Gaussian noise of a known sigma per channel,
+// normals and depth of a tilted plane.
+Passes noisy_plane(int w, int h, double sigma, unsigned seed) {
+  Passes ps;
+  ps.colour = Image(w, h, 3);
+  ps.normal = Image(w, h, 3);
+  ps.depth = Image(w, h, 1);
+  std::mt19937 rng(seed);
+  std::normal_distribution<float> noise(0.0f, float(sigma));
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      for (int c = 0; c < 3; ++c) ps.colour.at(x, y, c) = 1.0f + noise(rng);
+      ps.normal.at(x, y, 2) = 1.0f;
+      ps.depth.at(x, y, 0) = 2.0f + 0.01f * float(x + y);
+    }
+  return ps;
+}
+
+TEST(GuidedFilterTest, DefaultsFollowTheNoise) {
+  auto f = make_filter("guided");
+  EXPECT_EQ(f->params().get_enum("guide"), "normal_depth_colour");
+  EXPECT_EQ(f->params().get_int("radius"), 4);
+  EXPECT_EQ(f->params().get_float("epsilon"), 0.0);  // 0 = from the noise
+  EXPECT_EQ(f->params().get_float("epsilon_scale"), 30.0);
+  EXPECT_TRUE(f->params().get_bool("demodulate"));
+  // Other filters keep demodulate=false.
+  EXPECT_FALSE(make_filter("bilateral")->params().get_bool("demodulate"));
+  EXPECT_EQ(guided::auto_epsilon(30.0, 0.0), 1e-8);  // a noise-free frame: the smallest ridge
+  EXPECT_EQ(guided::auto_epsilon(30.0, 0.01), 30.0 * 0.01);
+  EXPECT_EQ(guided::auto_epsilon(30.0, kInf), 1e6);
+  EXPECT_EQ(guided::auto_epsilon(30.0, kNaN), 1e6);
+}
+
+// The estimator against noise of a known variance: on a flat frame of luminance 1 the
+// median relative noise variance is sigma^2 / (1 + 1e-3) (a median of chi^2 values
+// rescaled to their mean: within 35%), it grows with sigma^2, and the level is 1.
+TEST(GuidedFilterTest, FrameNoiseMeetsTheKnownNoise) {
+  double last = 0;
+  for (double sigma : {0.02, 0.05, 0.2}) {
+    SCOPED_TRACE(sigma);
+    const Passes ps = noisy_plane(96, 64, sigma, 40);
+    const guided::FrameNoise fn = guided::frame_noise(ps.colour, 2);
+    EXPECT_NEAR(fn.relative / (sigma * sigma), 1.0, 0.35);
+    EXPECT_GT(fn.relative, last * 4.0);
+    EXPECT_NEAR(fn.level, 1.0, 0.05);
+    last = fn.relative;
+  }
+  Image grey(8, 8, 3);
+  for (float& v : grey.storage()) v = 3.0f;
+  EXPECT_EQ(guided::frame_noise(grey, 1).relative, 0.0);  // noise-free
+  EXPECT_EQ(guided::frame_noise(grey, 1).level, 0.0);
+}
+
+// epsilon=0 runs exactly as epsilon = epsilon_scale x the median relative noise variance of
+// the colour it gets; a noisier frame is smoothed harder (closer to its mean).
+TEST(GuidedFilterTest, EpsilonFromTheNoiseIsTheDocumentedRule) {
+  for (double sigma : {0.02, 0.2}) {
+    SCOPED_TRACE(sigma);
+    const Frame f = frame_of(noisy_plane(48, 32, sigma, 41));
+    const Result autoe = run_with_defaults(f, {});
+    const double eps = guided::auto_epsilon(30.0, guided::frame_noise(f.image(Role::Colour), 1).relative);
+    ASSERT_FALSE(autoe.stats.guide_scale.empty());
+    EXPECT_NEAR(autoe.stats.guide_scale.back(), 1.0, 0.05);  // the colour guide: its level, not its std sigma
+    // Without a colour channel in the guide the level plays no part: the rule is epsilon alone.
+    const Params nd = {{"guide", std::string("normal_depth")}};
+    expect_close(run_with_defaults(f, nd).out, run_with_defaults(f, testutil::with(nd, {{"epsilon", eps}})).out, 0.0,
+                 "auto epsilon");
+    bool noted = false;
+    for (const std::string& n : autoe.notes) noted = noted || n.find("from the noise") != std::string::npos;
+    EXPECT_TRUE(noted);
+    // The residual noise: with epsilon ~ 30 noise variances of the colour guide, the slope on
+    // the colour is about 1 / 31 on a flat frame, and the window mean leaves 1 / 81.
+    double err = 0;
+    for (float v : autoe.out.storage()) err += (v - 1.0) * (v - 1.0);
+    err /= double(autoe.out.storage().size());
+    EXPECT_LT(err, 0.1 * sigma * sigma);
+  }
+}
+
+TEST(GuidedFilterTest, DemodulatesByDefaultWhenThereIsAnAlbedo) {
+  const Frame f = frame_of(random_passes(16, 12, 42));
+  const Result def = run_with_defaults(f, {});
+  const Result on = run_with_defaults(f, {{"demodulate", true}});
+  const Result off = run_with_defaults(f, {{"demodulate", false}});
+  expect_close(def.out, on.out, 0.0, "default = demodulate=true");
+  EXPECT_GT(testutil::changed(def.out, off.out), 0.1);
+  // No albedo pass: the default skips the step with a note; demodulate=true given is an error.
+  Passes no_albedo = random_passes(16, 12, 42);
+  no_albedo.albedo = Image();
+  const Frame g = frame_of(no_albedo);
+  Result skipped;
+  ASSERT_NO_THROW(skipped = run_with_defaults(g, {}));
+  expect_close(skipped.out, run_with_defaults(g, {{"demodulate", false}}).out, 0.0, "skipped = demodulate=false");
+  bool noted = false;
+  for (const std::string& n : skipped.notes) noted = noted || n.find("demodulation skipped") != std::string::npos;
+  EXPECT_TRUE(noted);
+  GuidedFilter explicit_on;
+  explicit_on.set("demodulate", true);
+  explicit_on.commit();
+  EXPECT_FALSE(explicit_on.missing_passes(g).empty());
+  try {
+    run_with_defaults(g, {{"demodulate", true}});
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_EQ(e.code(), Errc::MissingPass);
+    EXPECT_NE(std::string(e.what()).find("demodulate=true"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("test.exr"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace

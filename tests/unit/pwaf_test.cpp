@@ -195,12 +195,12 @@ TEST(PwafVarianceTest, VariancePassIsUsedWhenPresent) {
       for (int c = 0; c < 3; ++c) im.at(x, y, c) = 0.1f;
   Frame f = frame_of(im);
   f.passes.push_back(named_pass(Role::Variance, "variance", Image(32, 8, 1, 1e-8f)));
-  const PwafRun tight = run_pwaf(f, {{"adaptive", false}});
+  const PwafRun tight = run_pwaf(f, {{"adaptive", false}, {"demodulate", false}});
   EXPECT_TRUE(tight.stats.variance_from_pass);
   EXPECT_TRUE(tight.notes.size() == 3u) << "only the dropped weights are noted";
   EXPECT_NEAR(tight.out.at(15, 4, 0), 0.0f, 1e-4);
   f.passes.back().image = Image(32, 8, 1, 0.5f);
-  const PwafRun wide = run_pwaf(f, {{"adaptive", false}});
+  const PwafRun wide = run_pwaf(f, {{"adaptive", false}, {"demodulate", false}});
   EXPECT_GT(wide.out.at(15, 4, 0), 0.01f);
 }
 
@@ -421,7 +421,9 @@ TEST(PwafNotesTest, NamesTheDroppedWeightsWhenSecondHitPassesAreAbsent) {
 }
 
 TEST(PwafNotesTest, NoNoteWhenEveryPassIsPresent) {
-  const PwafRun r = run_pwaf(full_frame(16, 12, 33, /*second=*/true, /*variance=*/true));
+  Frame every = full_frame(16, 12, 33, /*second=*/true, /*variance=*/true);
+  every.passes.push_back(named_pass(Role::Albedo, "albedo", random_image(16, 12, 34, 0.1f, 1.0f)));
+  const PwafRun r = run_pwaf(every);
   EXPECT_TRUE(r.notes.empty()) << r.notes.front();
   // Without the variance pass only the estimate is noted, no weight is named.
   const PwafRun e = run_pwaf(full_frame(16, 12, 33, true, false));
@@ -658,6 +660,23 @@ TEST(PwafStressTest, RoiChangesOnlyPixelsInsideAndMatchesTheWholeFrame) {
           else ASSERT_EQ(part.out.at(x, y, c), in.at(x, y, c)) << x << "," << y;
         }
   }
+}
+
+// Demodulated by default (pwaf has no albedo weight): with an albedo pass the default is
+// demodulate=true; without one the step is skipped with a note, and only a demodulate=true
+// the user gave is an error.
+TEST(PwafNotesTest, DemodulatesByDefaultWhenThereIsAnAlbedo) {
+  EXPECT_TRUE(PwafFilter().params().get_bool("demodulate"));
+  Frame with_albedo = full_frame(20, 14, 37, true, false);
+  with_albedo.passes.push_back(named_pass(Role::Albedo, "albedo", random_image(20, 14, 38, 0.1f, 1.0f)));
+  EXPECT_EQ(run_pwaf(with_albedo).out.storage(), run_pwaf(with_albedo, {{"demodulate", true}}).out.storage());
+  EXPECT_NE(run_pwaf(with_albedo).out.storage(), run_pwaf(with_albedo, {{"demodulate", false}}).out.storage());
+  const Frame without = full_frame(20, 14, 37, true, false);
+  PwafRun skipped;
+  ASSERT_NO_THROW(skipped = run_pwaf(without));
+  EXPECT_TRUE(any_note_mentions(skipped.notes, "demodulation skipped"));
+  EXPECT_EQ(skipped.out.storage(), run_pwaf(without, {{"demodulate", false}}).out.storage());
+  EXPECT_THROW(run_pwaf(without, {{"demodulate", true}}), Error);
 }
 
 }  // namespace

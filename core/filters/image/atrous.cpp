@@ -15,8 +15,13 @@ namespace mcr {
 
 namespace {
 
+// Defaults chosen on the tune scenes (room, glossy; 1 to 64 spp): colour differences in
+// units of the estimated noise (4 standard deviations in the first pass, then decaying),
+// and a tighter albedo weight (0.05) that keeps the textures at 64 spp.
 ParamTable atrous_params() {
   FeatureDefaults d;
+  d.sigma[0] = 4.0;   // colour
+  d.sigma[3] = 0.05;  // albedo
   ParamTable t = {
       ParamSpec::Int("kernel_size", 5, 3, 9,
                      "generating kernel size k_g: 3 = [1 2 1]/4, 5 = [1 4 6 4 1]/16 (B3 spline, Dammertz), "
@@ -25,7 +30,11 @@ ParamTable atrous_params() {
                      "passes; pass i spaces the taps 2^(i-1) pixels apart (effective size k_g 2^(i-1))"),
   };
   for (ParamSpec& s : feature_params(d)) t.push_back(s);
-  t.push_back(colour_weight_param());
+  for (ParamSpec& s : t)
+    if (s.name == "colour_sigma") s.help += " (default 4 with colour_weight=noise: in noise standard deviations)";
+  ParamSpec cw = colour_weight_param();
+  cw.default_value = std::string("noise");
+  t.push_back(cw);
   t.push_back(ParamSpec::Float("colour_sigma_decay", 0.5, 0.05, 1.0,
                                "pass i uses colour_sigma * decay^(i-1): 0.5 halves it every pass as in Dammertz et al. "
                                "(sigma_rt 2^-i), 1 keeps it constant"));

@@ -14,6 +14,7 @@
 #include "filters/image/guided_guides.h"
 #include "filters/image/guided_sums.h"
 #include "image/luminance.h"
+#include "kernels/noise_scale.h"
 #include "util/error.h"
 #include "util/parallel.h"
 
@@ -23,11 +24,61 @@ using namespace guided;
 
 namespace {
 
+// epsilon=0: epsilon = kEpsilonScale x the median relative noise variance (chosen with
+// the radius and the guide on the tune scenes room and glossy, 1 to 64 spp).
+constexpr double kEpsilonScale = 30.0;
+
+// guided demodulates by default: its feature guide (normal, depth) carries no texture, so the
+// texture must leave the colour before the regression. Without an albedo pass the step is
+// skipped with a note (prepare/preparation.h), unless demodulate=true was given.
+ParamTable with_demodulate_default(ParamTable t) {
+  for (ParamSpec& s : t)
+    if (s.name == "demodulate") {  // with_preparation_params() adds it with default false
+      s.default_value = true;
+      s.help += " (guided: default true; skipped with a note when the render has no albedo pass and demodulate was "
+                "not given)";
+    }
+  return t;
+}
+
+}  // namespace
+
+double guided::auto_epsilon(double scale, double median_relative_noise) {
+  const double e = scale * median_relative_noise;
+  return std::isfinite(e) ? std::clamp(e, 1e-8, 1e6) : 1e6;
+}
+
+guided::FrameNoise guided::frame_noise(const Image& colour, int nthreads) {
+  const NoiseScales ns = estimate_noise_scales(colour, Roi::all(colour.width(), colour.height()), nthreads);
+  std::vector<double> rel, abs;
+  rel.reserve(ns.relative.size());
+  abs.reserve(ns.relative.size());
+  for (std::size_t i = 0; i < ns.relative.size(); ++i) {
+    if (!ns.finite[i]) continue;
+    if (std::isfinite(ns.relative[i])) rel.push_back(ns.relative[i]);
+    if (std::isfinite(ns.robust(i))) abs.push_back(ns.robust(i));
+  }
+  auto median = [](std::vector<double>& v) {
+    if (v.empty()) return 0.0;
+    auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
+    std::nth_element(v.begin(), mid, v.end());
+    return *mid;
+  };
+  FrameNoise fn;
+  fn.relative = median(rel);
+  const double a = median(abs);
+  fn.level = fn.relative > 0.0 && std::isfinite(a / fn.relative) ? std::sqrt(a / fn.relative) : 0.0;
+  return fn;
+}
+
+namespace {
+
 // The frame-wide pass (validity flags, guide normalisation, outlier threshold),
 // then the bands. Every reduction is per row, then combined in row order: the
 // same numbers on any thread count.
 template <int D>
-void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std::vector<bool>& unit, const Roi& roi,
+void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std::vector<bool>& unit,
+              const std::vector<double>& min_scale, const Roi& roi,
               Image& out, int nthreads, GuidedStats& st, std::vector<std::vector<double>>& work) {
   const int W = c.w, H = c.h;
   const std::size_t N = std::size_t(W) * std::size_t(H);
@@ -139,7 +190,8 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
     for (std::uint32_t v : row_out) outliers += v;
   }
 
-  // One scale per pass: s = rms std (s = 1 when that is 0), at least 1 for unit passes.
+  // One scale per pass: s = rms std (s = 1 when that is 0), at least 1 for unit passes,
+  // at least min_scale (a colour guide's level under epsilon=0).
   for (std::size_t g = 0; g < groups.size(); ++g) {
     const auto [first, count] = groups[g];
     double v = 0;
@@ -147,6 +199,7 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
     const double rms = std::sqrt(v / count);
     double s = rms > 0.0 && std::isfinite(rms) ? rms : 1.0;
     if (unit[g]) s = std::max(1.0, s);
+    if (min_scale[g] > 0.0 && std::isfinite(min_scale[g])) s = std::max(s, min_scale[g]);
     for (int j = first; j < first + count; ++j) {
       c.ch[std::size_t(j)].mean = mean[j];
       c.ch[std::size_t(j)].inv_scale = 1.0 / s;
@@ -186,16 +239,24 @@ const FilterInfo& GuidedFilter::static_info() {
         "He, Sun & Tang 2013 (Algorithm 1, multi-channel guide); Bauszat et al. 2011 (guide = normal + depth); "
         "Immonen 2017 thesis 3.5 and 4.2; Koskela et al. 2019 section 7 (radius 24/12, eps 0.01)";
     i.params = with_common_params({
-        ParamSpec::Enum("guide", "normal_depth", guide_names(),
+        ParamSpec::Enum("guide", "normal_depth_colour", guide_names(),
                         "guide channels: normal_depth = 3 normal channels + depth (Bauszat et al.); luminance and "
-                        "colour guide by the noisy colour itself (He et al.'s self-guided case); each pass is "
-                        "centred on its frame mean, depth/position/luminance/colour divided by their std, "
-                        "normal/albedo by max(1, std)"),
-        ParamSpec::Int("radius", 12, 1, 256, "half width of the box window in pixels (window = 2r+1); O(N): run time nearly independent of it"),
-        ParamSpec::Float("epsilon", 0.01, 1e-8, 1e6,
+                        "colour guide by the noisy colour itself (He et al.'s self-guided case); "
+                        "normal_depth_colour (default) adds the colour to normal + depth, so shadows, glossy "
+                        "reflections and lighting the features do not show are kept where they stand above the "
+                        "noise; each pass is "
+                        "centred on its frame mean, depth/position/luminance/colour divided by their std (a colour "
+                        "guide under epsilon=0 by max(std, its level)), normal/albedo by max(1, std)"),
+        ParamSpec::Int("radius", 4, 1, 256, "half width of the box window in pixels (window = 2r+1); O(N): run time nearly independent of it"),
+        ParamSpec::Float("epsilon", 0.0, 0.0, 1e6,
                          "ridge regulariser added to the guide covariance (guide channels normalised, see guide): "
-                         "larger = smoother, towards a box-of-box mean"),
+                         "larger = smoother, towards a box-of-box mean; 0 = from the noise: epsilon_scale x the "
+                         "frame's median relative noise variance (kernels/noise_scale.h), at least 1e-8"),
+        ParamSpec::Float("epsilon_scale", kEpsilonScale, 1e-6, 1e6,
+                         "epsilon=0: the multiple of the median relative noise variance taken as epsilon (a noisy "
+                         "render is smoothed hard, a clean one barely)"),
     });
+    i.params = with_demodulate_default(std::move(i.params));
     i.required = {Role::Colour};
     i.optional = {Role::Normal, Role::Depth, Role::Position, Role::Albedo};
     i.nonfinite_policy =
@@ -227,6 +288,12 @@ PassNeeds GuidedFilter::own_needs() const {
   return n;
 }
 
+std::vector<std::string> GuidedFilter::own_unused() const {
+  std::vector<std::string> u = Filter::own_unused();
+  unused_when(params_.get_float("epsilon") != 0.0, "epsilon_scale", "with epsilon set (only epsilon=0 reads it)", u);
+  return u;
+}
+
 void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& roi, Image& out, int nthreads) {
   const std::string& guide = params_.get_enum("guide");
   const GuideChoice& choice = find_choice(guide);  // its passes: checked by needs() before any work
@@ -241,9 +308,18 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   c.h = H;
   c.r = r;
   c.eps = params_.get_float("epsilon");
+  double colour_scale = 0;  // epsilon=0: a colour guide is divided by at least its level
+  if (c.eps == 0.0) {
+    const FrameNoise fn = frame_noise(*colour, nthreads);
+    c.eps = auto_epsilon(params_.get_float("epsilon_scale"), fn.relative);
+    colour_scale = fn.level;
+    note("epsilon " + number_text(c.eps) + " from the noise (median relative noise variance " + number_text(fn.relative) +
+         ", colour level " + number_text(fn.level) + ")");
+  }
   c.colour = colour->data();
   std::vector<std::pair<int, int>> groups;  // first channel, count
   std::vector<bool> unit;
+  std::vector<double> min_scale;
   int d = 0;
   for (const GroupSpec& g : active_groups(choice, frame, c.eps, nthreads, [this](std::string s) { note(std::move(s)); })) {
     const Image* img = nullptr;
@@ -265,6 +341,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
     }
     groups.emplace_back(d, g.channels);
     unit.push_back(g.unit);
+    min_scale.push_back(g.source == Source::Colour || g.source == Source::Luminance ? colour_scale : 0.0);
     for (int j = 0; j < g.channels; ++j, ++d) {
       c.ch[std::size_t(d)].data = img->data();
       c.ch[std::size_t(d)].stride = img->channels();
@@ -274,11 +351,11 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
 
   stats_ = GuidedStats{};
   switch (d) {
-    case 1: filter_d<1>(c, groups, unit, roi, out, nthreads, stats_, work_); break;
-    case 3: filter_d<3>(c, groups, unit, roi, out, nthreads, stats_, work_); break;
-    case 4: filter_d<4>(c, groups, unit, roi, out, nthreads, stats_, work_); break;
-    case 6: filter_d<6>(c, groups, unit, roi, out, nthreads, stats_, work_); break;
-    case 7: filter_d<7>(c, groups, unit, roi, out, nthreads, stats_, work_); break;
+    case 1: filter_d<1>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
+    case 3: filter_d<3>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
+    case 4: filter_d<4>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
+    case 6: filter_d<6>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
+    case 7: filter_d<7>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
     default: throw Error(Errc::Internal, "filter 'guided': no kernel for a " + std::to_string(d) + "-channel guide");
   }
 }

@@ -14,7 +14,7 @@
 // windows that contain pixel i (centres k inside the image, within r of i, with at
 // least one valid pixel): q_i = mean_k (a_k . z_i + b_k).
 //
-// Guide normalisation (so that one eps fits every guide): every guide channel is
+// Guide normalisation (so that one eps fits every guide; epsilon=0 below): every guide channel is
 // centred on its mean over the frame, then divided by a scale shared by the channels
 // of one pass (normal xyz, position xyz, albedo rgb, colour rgb share theirs):
 //   normal, albedo          s = max(1, rms std)  unit quantities keep their own scale
@@ -52,6 +52,25 @@
 
 namespace mcr {
 
+namespace guided {
+// epsilon=0 (the default): epsilon = scale x the frame's median relative noise variance,
+// clamped to [1e-8, 1e6] (1e6 when not finite): a noisy frame is smoothed hard, a clean one
+// barely. The noise is kernels/noise_scale.h's, taken on the colour the filter gets (after
+// demodulation), medians over the finite pixels (0 when none):
+//   relative  the median of `relative` (high-pass residual energy over median
+//             luminance^2, robust to sparse bright structure);
+//   level     sqrt(median of robust() / relative): the colour level that noise is relative to.
+// A colour guide (colour, luminance, normal_depth_colour) is then divided by
+// max(rms std, level) instead of its rms std: its noise variance in guide units is at most
+// about the relative one, so epsilon is `scale` noise variances for it too, and a flat
+// noisy frame (std = noise) is smoothed instead of taken as structure.
+struct FrameNoise {
+  double relative = 0, level = 0;
+};
+FrameNoise frame_noise(const Image& colour, int nthreads);
+double auto_epsilon(double scale, double median_relative_noise);
+}  // namespace guided
+
 // What the last execute() did, for tests and --verbose tools.
 struct GuidedStats {
   int guide_channels = 0;          // d
@@ -75,6 +94,7 @@ class GuidedFilter : public Filter {
 
  protected:
   PassNeeds own_needs() const override;
+  std::vector<std::string> own_unused() const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:

@@ -28,6 +28,7 @@ const std::vector<GuideChoice>& guide_choices() {
       {"normal_depth_albedo", {kNormal, kDepth, kAlbedo}},
       {"luminance", {{Source::Luminance, 1, false}}},
       {"colour", {{Source::Colour, 3, false}}},
+      {"normal_depth_colour", {kNormal, kDepth, {Source::Colour, 3, false}}},
   };
   return list;
 }
