@@ -1,5 +1,7 @@
 #include "io/half_buffers.h"
 
+#include <algorithm>
+
 #include "util/error.h"
 
 namespace mcr {
@@ -27,7 +29,7 @@ Frame combine_halves(Frame first, const Frame& second) {
       float* v = var.image.pixel(x, y);
       for (int c = 0; c < 3; ++c) {
         const double d = double(p[c]) - double(q[c]);
-        v[c] = float(d * d / 4.0);
+        v[c] = float(std::min(d * d / 4.0, 3.0e38));  // beyond the float range: the largest float
         p[c] = float(0.5 * double(p[c]) + 0.5 * double(q[c]));
       }
     }

@@ -15,6 +15,7 @@ constexpr int kTile = 8, kTileGrow = 4;
 constexpr double kRelativeEps = 1e-3;  // luminance^2 below which noise counts as absolute
 constexpr double kChi2MedianToMean = 1.27;
 constexpr double kFloorRelative = 0.02;
+constexpr double kRareOutliers = 0.03;  // share of a tile's pixels
 
 // The frame's RGB at (x, y) and whether it is finite.
 struct Rgb {
@@ -125,7 +126,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
         e += r * r;
       }
       // Var(y - mean of nn neighbours) = s^2 (1 + 1/nn).
-      erel[i] = float(e / 3.0 / (1.0 + 1.0 / nn) / (my2 + kRelativeEps));
+      erel[i] = float(std::min(e / 3.0 / (1.0 + 1.0 / nn) / (my2 + kRelativeEps), 3.0e38));
       eok[i] = 1;
     }
   });
@@ -148,6 +149,72 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
           buf.empty() ? 0.0f : float(kChi2MedianToMean) * median_of(buf.data(), int(buf.size()));
     }
   });
+
+  // The excess of every pixel the variance reads (a firefly's own), before the variance:
+  // a firefly takes no part in it, or its one sample would spread its energy over the
+  // window of every pixel near it (the step back and auto treat it by itself).
+  const Roi E = s.box.grown(kVarianceRadius + 1, W, H);
+  std::vector<float> exc(std::size_t(E.width()) * std::size_t(E.height()), 0.0f);
+  auto tile_of = [&](int x, int yy) {
+    const int tx = std::min(std::max((x - s.box.x0) / kTile, 0), ntx - 1);
+    const int ty = std::min(std::max((yy - s.box.y0) / kTile, 0), nty - 1);
+    return tile_rel[std::size_t(ty) * std::size_t(ntx) + std::size_t(tx)];
+  };
+  parallel_rows(E.y0, E.y1, nthreads, [&](int yy) {
+    for (int x = E.x0; x < E.x1; ++x) {
+      if (!ok(x, yy)) continue;
+      const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
+      const float* p = y.at(x, yy);
+      float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+      bool any = false;
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int qx = x + dx, qy = yy + dy;
+          if ((!dx && !dy) || !ok(qx, qy)) continue;
+          const float* q = y.at(qx, qy);
+          for (int c = 0; c < 3; ++c) {
+            lo[c] = any ? std::min(lo[c], q[c]) : q[c];
+            hi[c] = any ? std::max(hi[c], q[c]) : q[c];
+          }
+          any = true;
+        }
+      const double rel = tile_of(x, yy);
+      double dev = 0;
+      for (int c = 0; c < 3; ++c) {
+        const double m = med[i * 3 + std::size_t(c)];
+        const double robust = std::min(std::max(rel * (m * m + kRelativeEps), kFloorRelative * kFloorRelative * m * m), 3.0e38);
+        const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
+        dev += out * out / std::max(robust, 1e-30);
+      }
+      exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] = float(std::min(dev / 3.0, 3.0e38));
+    }
+  });
+  // Where outliers are many (a 1-spp render lit by rare paths), they are the noise itself and
+  // stay in: only a tile (8x8, grown by 4) whose outliers are under kRareOutliers of its
+  // pixels leaves them out.
+  std::vector<std::uint8_t> rare(std::size_t(ntx) * std::size_t(nty), 0);
+  parallel_rows(0, nty, nthreads, [&](int ty) {
+    for (int tx = 0; tx < ntx; ++tx) {
+      const int x0 = s.box.x0 + tx * kTile, y0 = s.box.y0 + ty * kTile;
+      const Roi win = Roi{x0, y0, x0 + kTile, y0 + kTile}.grown(kTileGrow, W, H);
+      int n = 0, out = 0;
+      for (int yy = std::max(win.y0, E.y0); yy < std::min(win.y1, E.y1); ++yy)
+        for (int x = std::max(win.x0, E.x0); x < std::min(win.x1, E.x1); ++x) {
+          if (!ok(x, yy)) continue;
+          ++n;
+          out += exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] > kOutlierSigmas * kOutlierSigmas;
+        }
+      rare[std::size_t(ty) * std::size_t(ntx) + std::size_t(tx)] = out <= kRareOutliers * n;
+    }
+  });
+  auto calm = [&](int x, int yy) {  // finite, and not a rare outlier
+    if (!ok(x, yy)) return false;
+    if (exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] <= kOutlierSigmas * kOutlierSigmas)
+      return true;
+    const int tx = std::min(std::max((x - s.box.x0) / kTile, 0), ntx - 1);
+    const int ty = std::min(std::max((yy - s.box.y0) / kTile, 0), nty - 1);
+    return !rare[std::size_t(ty) * std::size_t(ntx) + std::size_t(tx)];
+  };
 
   // z(q) = mean over the 2 axis directions d and R, G, B of (y(q) - y(q - d)) (y(q) - y(q + d)), over
   // the box grown by the variance window.
@@ -177,13 +244,13 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
           continue;
         }
       }
-      if (!ok(x, yy)) continue;
+      if (!calm(x, yy)) continue;
       const float* p = y.at(x, yy);
       double sum = 0;
       int cnt = 0;
       for (const auto& d : dirs) {
         const int ax = x - d[0], ay = yy - d[1], bx = x + d[0], by = yy + d[1];
-        if (!ok(ax, ay) || !ok(bx, by)) continue;
+        if (!calm(ax, ay) || !calm(bx, by)) continue;
         const float* a = y.at(ax, ay);
         const float* b = y.at(bx, by);
         for (int c = 0; c < 3; ++c) sum += (double(p[c]) - a[c]) * (double(p[c]) - b[c]);
@@ -200,29 +267,11 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       if (!ok(x, yy)) continue;
       s.finite[o] = 1;
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
-      double dev = 0;
-      const float* p = y.at(x, yy);
-      float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
-      bool any = false;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = x + dx, qy = yy + dy;
-          if ((!dx && !dy) || !ok(qx, qy)) continue;
-          const float* q = y.at(qx, qy);
-          for (int c = 0; c < 3; ++c) {
-            lo[c] = any ? std::min(lo[c], q[c]) : q[c];
-            hi[c] = any ? std::max(hi[c], q[c]) : q[c];
-          }
-          any = true;
-        }
       for (int c = 0; c < 3; ++c) s.median[o * 3 + std::size_t(c)] = med[i * 3 + std::size_t(c)];
-      s.relative[o] = tile_rel[std::size_t((yy - s.box.y0) / kTile) * std::size_t(ntx) + std::size_t((x - s.box.x0) / kTile)];
-      for (int c = 0; c < 3; ++c) {
-        const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
-        dev += out * out / std::max(s.robust(o, c), 1e-30);
-      }
-      s.excess[o] = float(std::min(dev / 3.0, 3.0e38));
-      s.outlier[o] = dev / 3.0 > kOutlierSigmas * kOutlierSigmas ? 1 : 0;
+      s.relative[o] = tile_of(x, yy);
+      const float e = exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
+      s.excess[o] = e;
+      s.outlier[o] = e > kOutlierSigmas * kOutlierSigmas ? 1 : 0;
       s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0), 0.0), 3.0e38));
     }
   });

@@ -10,7 +10,10 @@
 //                corner where four regions meet and on a pixel staircase too, which a
 //                diagonal would not), a ramp of slope g adds -g^2, so edges cancel and
 //                smooth shading or a pixel filter's blur make it err low.
-//                A one-pixel peak counts as noise.
+//                Outliers (below) take no part where they are rare (under 3% of a tile):
+//                one firefly's sample would otherwise spread its energy over the window of
+//                every pixel near it; where they are many (a 1-spp render lit by rare
+//                paths) they are the noise itself and count.
 //   median(p)    per-channel median of the finite pixels of the 3x3 neighbourhood.
 //   relative(p)  a relative noise level sparse bright structure cannot inflate: the
 //                median, over a tile (4x4 pixels grown by 4), of the 8-neighbour high-pass

@@ -129,7 +129,8 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
         if (!s.noise.finite[i]) continue;
         const double eps = std::max(kProbe * std::sqrt(s.noise.robust(i, c)), 1e-6);
         const double b = (st >> 63) ? 1.0 : -1.0;
-        colour->image.at(x, yy, c) = float(double(colour->image.at(x, yy, c)) + b * eps);
+        const double probed = double(colour->image.at(x, yy, c)) + b * eps;
+        colour->image.at(x, yy, c) = float(std::min(std::max(probed, -3.4e38), 3.4e38));
         s.sign_over_eps[k] = float(b / eps);
       }
     }
