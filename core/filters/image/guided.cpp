@@ -53,8 +53,10 @@ guided::FrameNoise guided::frame_noise(const Image& colour, int nthreads) {
   std::vector<double> rel, abs;
   rel.reserve(ns.relative.size());
   abs.reserve(ns.relative.size());
+  // Over the pixels whose tile measured any noise: at 1 spp a render lit by rare paths is
+  // mostly black, and a black tile's noise is not 0 but unmeasured (its median is 0).
   for (std::size_t i = 0; i < ns.relative.size(); ++i) {
-    if (!ns.finite[i]) continue;
+    if (!ns.finite[i] || !(ns.relative[i] > 0)) continue;
     if (std::isfinite(ns.relative[i])) rel.push_back(ns.relative[i]);
     if (std::isfinite(ns.robust(i))) abs.push_back(ns.robust(i));
   }
