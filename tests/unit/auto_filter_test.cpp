@@ -51,16 +51,7 @@ Frame blocks(int w, int h, double sigma, unsigned seed, Image* clean_out, double
   return f;
 }
 
-double relmse(const Image& a, const Image& ref) {
-  double s = 0;
-  for (int y = 0; y < a.height(); ++y)
-    for (int x = 0; x < a.width(); ++x)
-      for (int c = 0; c < 3; ++c) {
-        const double d = double(a.at(x, y, c)) - ref.at(x, y, c);
-        s += d * d / (double(ref.at(x, y, c)) * ref.at(x, y, c) + 0.01);
-      }
-  return s / (3.0 * double(a.pixel_count()));
-}
+double relmse(const Image& a, const Image& ref) { return testutil::relmse_oracle(a, ref); }
 
 Image run_auto(const Frame& f, AutoFilter& a, Roi roi = {}) {
   a.commit();

@@ -17,20 +17,6 @@ namespace {
 
 using namespace testutil;
 
-// Mean of the colour over the (2r+1)^2 window clipped at the borders, in double.
-Image box_oracle(const Image& in, int r) {
-  Image out(in.width(), in.height(), 3);
-  for (int y = 0; y < in.height(); ++y)
-    for (int x = 0; x < in.width(); ++x)
-      for (int c = 0; c < 3; ++c) {
-        double s = 0;
-        int n = 0;
-        for (int qy = std::max(0, y - r); qy <= std::min(in.height() - 1, y + r); ++qy)
-          for (int qx = std::max(0, x - r); qx <= std::min(in.width() - 1, x + r); ++qx, ++n) s += in.at(qx, qy, c);
-        out.at(x, y, c) = float(s / n);
-      }
-  return out;
-}
 
 ImageMetrics metrics_oracle(const Image& ref, const Image& img) {
   double se = 0, rel = 0, se_clamped = 0;

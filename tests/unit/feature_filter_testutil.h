@@ -36,6 +36,33 @@ inline bool finite_n(const float* p, int n) {
   return true;
 }
 
+// Mean of the colour over the (2r+1)^2 window clipped at the borders, in double.
+inline Image box_oracle(const Image& in, int r) {
+  Image out(in.width(), in.height(), 3);
+  for (int y = 0; y < in.height(); ++y)
+    for (int x = 0; x < in.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        double s = 0;
+        int n = 0;
+        for (int qy = std::max(0, y - r); qy <= std::min(in.height() - 1, y + r); ++qy)
+          for (int qx = std::max(0, x - r); qx <= std::min(in.width() - 1, x + r); ++qx, ++n) s += in.at(qx, qy, c);
+        out.at(x, y, c) = float(s / n);
+      }
+  return out;
+}
+
+// relMSE of the RGB of `a` against `ref` as the metrics define it, written out plainly.
+inline double relmse_oracle(const Image& a, const Image& ref) {
+  double s = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double d = double(a.at(x, y, c)) - ref.at(x, y, c);
+        s += d * d / (double(ref.at(x, y, c)) * ref.at(x, y, c) + 0.01);
+      }
+  return s / (3.0 * double(a.pixel_count()));
+}
+
 inline Image random_image(int w, int h, int ch, unsigned seed, float lo = 0.0f, float hi = 1.0f) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> dist(lo, hi);

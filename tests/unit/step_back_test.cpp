@@ -32,34 +32,9 @@ Image scene(int w, int h, double rel_sigma, unsigned seed, Image* clean_out = nu
   return noisy;
 }
 
-Image box_blur(const Image& in, int r) {
-  Image out(in.width(), in.height(), 3);
-  for (int y = 0; y < in.height(); ++y)
-    for (int x = 0; x < in.width(); ++x)
-      for (int c = 0; c < 3; ++c) {
-        double s = 0;
-        int n = 0;
-        for (int yy = std::max(0, y - r); yy <= std::min(in.height() - 1, y + r); ++yy)
-          for (int xx = std::max(0, x - r); xx <= std::min(in.width() - 1, x + r); ++xx) {
-            s += in.at(xx, yy, c);
-            ++n;
-          }
-        out.at(x, y, c) = float(s / n);
-      }
-  return out;
-}
+Image box_blur(const Image& in, int r) { return testutil::box_oracle(in, r); }
 
-// relMSE as the metrics define it.
-double relmse(const Image& a, const Image& ref) {
-  double s = 0;
-  for (int y = 0; y < a.height(); ++y)
-    for (int x = 0; x < a.width(); ++x)
-      for (int c = 0; c < 3; ++c) {
-        const double d = double(a.at(x, y, c)) - ref.at(x, y, c);
-        s += d * d / (double(ref.at(x, y, c)) * ref.at(x, y, c) + 0.01);
-      }
-  return s / (3.0 * double(a.pixel_count()));
-}
+double relmse(const Image& a, const Image& ref) { return testutil::relmse_oracle(a, ref); }
 
 TEST(StepBack, ACleanRenderStaysAsItWas) {
   Image clean;
