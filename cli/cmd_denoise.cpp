@@ -96,11 +96,11 @@ int run_denoise(const DenoiseArgs& a) {
     inputs.push_back(j.first);
   }
   for (std::string& f : loose_pass_files(ro)) inputs.push_back(std::move(f));  // --pass normal=n.exr
-  for (const std::string& h : halves) {
+  for (std::size_t i = 0; i < halves.size(); ++i) {
+    const std::string& h = halves[i];
     std::error_code ec;
     if (!std::filesystem::exists(h, ec)) throw Error(Errc::FileNotFound, "cannot read --half '" + h + "': no such file");
-    const std::string& own = jobs[std::size_t(&h - halves.data())].first;
-    if (std::filesystem::equivalent(h, own, ec))
+    if (std::filesystem::equivalent(h, jobs[i].first, ec))
       throw Error(Errc::InvalidArgument, "--half '" + h + "' is the input itself: give the other half buffer");
     inputs.push_back(h);
   }

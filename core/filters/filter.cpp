@@ -1,7 +1,6 @@
 #include "filters/filter.h"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
@@ -10,16 +9,6 @@
 #include "util/isa.h"
 
 namespace mcr {
-
-namespace {
-
-std::string fixed_text(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*f", digits, v);
-  return buf;
-}
-
-}  // namespace
 
 ParamTable with_common_params(ParamTable own) { return with_preparation_params(std::move(own), PrepSteps{}); }
 
@@ -172,8 +161,8 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     const Pass* variance = prepared_.frame->find(Role::Variance);
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
                                        nthreads, out, variance ? &variance->image : nullptr);
-    note(std::string("step_back") + (variance ? " (noise from the variance pass)" : "") + ": mean weight of the filtered result " + fixed_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
-         fixed_text(100.0 * sb.input_share, 1) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
+    note(std::string("step_back") + (variance ? " (noise from the variance pass)" : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
+         rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
   prepared_.own = Frame{};  // the copied passes are not kept between frames
   prepared_.colour = Image{};

@@ -4,7 +4,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <memory>
 
 #include "filters/registry.h"
@@ -22,12 +21,6 @@ constexpr int kMinTiles = 4;
 constexpr double kScoreSigmas = 2.0;
 constexpr double kRelMseEps = 0.01;
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
-
-std::string fixed(double v, int digits) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
-}
 
 // The frame's passes inside r (a new, smaller frame).
 Frame crop(const Frame& f, const Roi& r) {
@@ -261,7 +254,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   }
   std::stable_sort(scores_.begin(), scores_.end(), [](const AutoScore& a, const AutoScore& b) { return a.relmse < b.relmse; });
   std::string table;
-  for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + fixed(s.relmse, 3);
+  for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + rounded_text(s.relmse, 3);
   note("auto: estimated relMSE on " + std::to_string(tiles.size()) + (tiles.size() == 1 ? " sample (the whole region)" : " tiles") +
        " (SURE: only the order counts; below 0 where the noise estimate runs high): " + table);
 
@@ -269,8 +262,8 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   const double input_score = in_sum / n;
   if (input_score < params_.get_float("converged")) {
     chosen_ = "input";
-    note("auto: chose the input as it is: converged (estimated relMSE " + fixed(input_score, 3) + " < converged=" +
-         fixed(params_.get_float("converged"), 3) + ")");
+    note("auto: chose the input as it is: converged (estimated relMSE " + rounded_text(input_score, 3) + " < converged=" +
+         rounded_text(params_.get_float("converged"), 3) + ")");
     return;
   }
   const AutoScore* best = nullptr;
@@ -281,8 +274,8 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     }
   if (!best || !(best->relmse < (1.0 - params_.get_float("min_gain")) * input_score)) {
     chosen_ = "input";
-    note("auto: chose the input as it is: no filter is estimated to cut its relMSE (" + fixed(input_score, 3) + ") by " +
-         fixed(100.0 * params_.get_float("min_gain"), 3) + "%");
+    note("auto: chose the input as it is: no filter is estimated to cut its relMSE (" + rounded_text(input_score, 3) + ") by " +
+         rounded_text(100.0 * params_.get_float("min_gain"), 3) + "%");
     return;  // out holds the input colour
   }
   chosen_ = best->filter;

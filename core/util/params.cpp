@@ -63,6 +63,12 @@ std::string number_text(double v) {
   return buf;
 }
 
+std::string rounded_text(double v, int digits) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
+  return buf;
+}
+
 std::string param_value_text(const ParamValue& v) {
   if (auto i = std::get_if<std::int64_t>(&v)) return std::to_string(*i);
   if (auto d = std::get_if<double>(&v)) return number_text(*d);

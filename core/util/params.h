@@ -68,6 +68,8 @@ void report_unused(const ParamSet& params, const std::string& name, const std::s
 
 // The fewest %g digits that read back as v: "0.1", "1e+20", "inf".
 std::string number_text(double v);
+// v to `digits` significant digits (%g), for figures in notes: "0.81", "18.8", "1.2e-05".
+std::string rounded_text(double v, int digits);
 std::string param_value_text(const ParamValue& v);  // "5", "0.25", "true", "gaussian"
 // "[0, 64]" for numbers (">= 0 (no upper bound)" when a bound is infinite or the type's
 // end), "one of: a, b" for enums, "" for bools.
