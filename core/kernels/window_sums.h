@@ -33,6 +33,7 @@ class WindowSums {
     if (counts_) box(cnt_, r, nthreads);
   }
   double value(int x, int y) const { return val_[index(x, y)]; }
+  double count(int x, int y) const { return counts_ ? cnt_[index(x, y)] : 0.0; }
   double mean(int x, int y) const {
     const double c = cnt_[index(x, y)];
     return c > 0 ? val_[index(x, y)] / c : 0.0;

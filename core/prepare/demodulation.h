@@ -2,11 +2,19 @@
 // Albedo demodulation (preparation step `demodulate`, and bmfr's own fused one): the
 // colour is divided by the albedo so a filter smooths the illumination, not the
 // texture, and multiplied back after. One rule for every user:
-//   a = max(albedo, floor) where the albedo is finite, 1 where it is not;
+//   a = min(max(albedo, floor), ceiling) where the albedo is finite, 1 where it is not;
 //   a = max(a, |colour| * 2^-126) where the colour is finite;
-// no upper clamp (Blender's Denoising Albedo exceeds 1 on highlights, >100 near
-// lights), and dividing and multiplying by the same value is exact. The second line keeps
-// colour / a within 2^126, so a finite colour near FLT_MAX over a dark albedo does not
+// and dividing and multiplying by the same value is exact.
+// The ceiling (kAlbedoCeiling = 1 for the image filters): a reflectance is at most 1, so
+// an albedo above 1 holds light, not texture (Blender's Denoising Albedo follows a
+// mirror's bounce: where that sample hit a lamp or the sun it reads ~200, the next
+// sample 0.4). Divided by such a value a spatial filter would take the neighbour's
+// illumination and remodulation would multiply it by 200; capped, such a pixel is not
+// demodulated in that channel and its light stays in the illumination, where the outlier
+// rules and the step back see it. bmfr passes no ceiling (+inf) and leaves such pixels
+// out of its fit instead (filters/temporal/bmfr.h): its history is reprojected
+// bilinearly, and an undivided highlight would bleed into the neighbours' histories.
+// The second line keeps colour / a within 2^126, so a finite colour near FLT_MAX over a dark albedo does not
 // overflow to inf (and come back as 0); it never acts below |colour| = 2^126 * a (8.5e37 a),
 // so ordinary images are divided by the albedo as they always were.
 #include <algorithm>
@@ -16,19 +24,23 @@
 
 namespace mcr {
 
-inline float demodulation_albedo(float v, float floor) { return (v - v == 0.0f) ? std::max(v, floor) : 1.0f; }
+constexpr float kAlbedoCeiling = 1.0f;
+
+inline float demodulation_albedo(float v, float floor, float ceiling = kAlbedoCeiling) {
+  return (v - v == 0.0f) ? std::min(std::max(v, floor), ceiling) : 1.0f;
+}
 
 // The divisor of one colour value c over albedo v (the rule above). 2^-126 is FLT_MIN, a
 // normal float (no flush-to-zero concern), and |c| * 2^-126 is exact where it matters.
-inline float demodulation_divisor(float v, float c, float floor) {
+inline float demodulation_divisor(float v, float c, float floor, float ceiling = kAlbedoCeiling) {
   const float need = (c - c == 0.0f) ? std::fabs(c) * 0x1p-126f : 0.0f;
-  return std::max(demodulation_albedo(v, floor), need);
+  return std::max(demodulation_albedo(v, floor, ceiling), need);
 }
 
 // One row of n pixels: al = the divisor per channel (an albedo of fewer than 3 channels
 // repeats its last one), il = colour / al. colour, al and il are RGB.
 void demodulate_row(const float* albedo, int albedo_channels, const float* colour, int n, float floor, float* al,
-                    float* il);
+                    float* il, float ceiling = kAlbedoCeiling);
 
 // Inside roi: divisor(x, y) = the rule above on `albedo`, colour(x, y) /= divisor. Both
 // RGB, the frame's size; pixels outside roi are not touched.

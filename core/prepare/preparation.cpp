@@ -16,8 +16,8 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
   if (steps.demodulate) {
     own.push_back(ParamSpec::Bool("demodulate", false, "divide the colour by the albedo pass before filtering and multiply after"));
     own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0,
-                                   "albedo is raised to at least albedo_floor for demodulation (no upper clamp: colour is "
-                                   "divided and multiplied by the same value, and Blender's albedo exceeds 1 on highlights)"));
+                                   "albedo is raised to at least albedo_floor for demodulation and capped at 1 (an albedo above 1 "
+                                   "holds light: Blender's follows a mirror's bounce to a lamp)"));
   }
   if (steps.albedo_prefilter) {
     own.push_back(ParamSpec::Float("albedo_prefilter", 0.0, 0.0, 10.0,

@@ -37,8 +37,14 @@ namespace {
 // channel count fixed, so the history and the blend stay in registers. Same operations in
 // the same order.
 // Pixels [xb, w) of the row.
+// Rec. 709 luminance weights in float (the guards' luminance; image/luminance.h in double).
+constexpr float kY0 = 0.2126f, kY1 = 0.7152f, kY2 = 0.0722f;
+
 void row3(int y, const Reprojection& r, const float* crow_all, const float* hist, const float* hcount, float af,
-          int w, float* orow, float* ncount, int xb = 0) {
+          int w, float* orow, float* ncount, const AccumulationGuards& g, int xb = 0) {
+  const float* lim = g.limit ? g.limit + std::size_t(y) * std::size_t(w) : nullptr;
+  const float* afl = g.alpha_floor ? g.alpha_floor + std::size_t(y) * std::size_t(w) : nullptr;
+  const float hf = g.history_factor;
   const float* crow = crow_all + std::size_t(y) * std::size_t(w) * 3;
   const std::uint8_t* taps = r.taps.data() + std::size_t(y) * std::size_t(w);
   const float* pxs = r.prev_x.data() + std::size_t(y) * std::size_t(w);
@@ -47,7 +53,7 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
   for (int x = xb; x < w; ++x) {
     const float* c = crow + std::size_t(x) * 3;
     float* o = orow + std::size_t(x) * 3;
-    const float c0 = c[0], c1 = c[1], c2 = c[2];
+    float c0 = c[0], c1 = c[1], c2 = c[2];
     const bool finite = ((c0 - c0) + (c1 - c1) + (c2 - c2)) == 0.0f;  // x - x is NaN for NaN/Inf
     float h0 = 0, h1 = 0, h2 = 0, n = 0;
     bool have = false;
@@ -81,6 +87,27 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
         have = true;
       }
     }
+    if (lim && afl && have && afl[x] > af) {  // responsive: no brighter than the neighbourhood backs
+      const float bound = std::max(lim[x], 0.0f);
+      const float yh = kY0 * h0 + kY1 * h1 + kY2 * h2;
+      if (yh > bound) {
+        const float sc = bound / yh;
+        h0 *= sc;
+        h1 *= sc;
+        h2 *= sc;
+      }
+    }
+    if (lim && finite) {
+      const float yh = have ? kY0 * h0 + kY1 * h1 + kY2 * h2 : 0.0f;
+      const float bound = std::max(std::max(lim[x], hf * yh), 0.0f);
+      const float yc = kY0 * c0 + kY1 * c1 + kY2 * c2;
+      if (yc > bound) {
+        const float sc = bound / yc;
+        c0 *= sc;
+        c1 *= sc;
+        c2 *= sc;
+      }
+    }
     if (!finite) {
       o[0] = have ? h0 : 0.0f;  // invalid without history: value 0, count 0
       o[1] = have ? h1 : 0.0f;
@@ -95,7 +122,7 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
       ncount[x] = 1.0f;
       continue;
     }
-    const float wn = std::max(1.0f / (n + 1.0f), af);
+    const float wn = std::max(1.0f / (n + 1.0f), afl ? std::max(af, afl[x]) : af);
     o[0] = h0 + wn * (c0 - h0);
     o[1] = h1 + wn * (c1 - h1);
     o[2] = h2 + wn * (c2 - h2);
@@ -109,8 +136,13 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
 // row3 in the same order, so the results are the same bit for bit). The taps are
 // gathered; a tap that row3 skips leaves the sums untouched (blend, not + 0).
 __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, const float* crow_all, const float* hist,
-                                               const float* hcount, float af, int w, float* orow, float* ncount) {
+                                               const float* hcount, float af, int w, float* orow, float* ncount,
+                                               const AccumulationGuards& g) {
   const std::size_t rb = std::size_t(y) * std::size_t(w);
+  const float* lim = g.limit ? g.limit + rb : nullptr;
+  const float* afl = g.alpha_floor ? g.alpha_floor + rb : nullptr;
+  const __m256 hfv = _mm256_set1_ps(g.history_factor), ky0 = _mm256_set1_ps(kY0), ky1 = _mm256_set1_ps(kY1),
+               ky2 = _mm256_set1_ps(kY2);
   const float* crow = crow_all + rb * 3;
   const std::uint8_t* taps = r.taps.data() + rb;
   const float* pxs = r.prev_x.data() + rb;
@@ -203,9 +235,31 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
       const __m256 rc = _mm256_cvtepi32_ps(_mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(cnt, inv), half)));
       n = _mm256_and_ps(have, _mm256_max_ps(rc, one));
     }
+    if (lim && afl) {  // row3's history cap on responsive pixels, the same operations
+      const __m256 bound = _mm256_max_ps(zero, _mm256_loadu_ps(lim + x));
+      const __m256 resp = _mm256_and_ps(have, _mm256_cmp_ps(_mm256_loadu_ps(afl + x), afv, _CMP_GT_OQ));
+      const __m256 yh = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, h0), _mm256_mul_ps(ky1, h1)), _mm256_mul_ps(ky2, h2));
+      const __m256 cut = _mm256_and_ps(resp, _mm256_cmp_ps(yh, bound, _CMP_GT_OQ));
+      const __m256 sc = _mm256_div_ps(bound, yh);
+      h0 = _mm256_blendv_ps(h0, _mm256_mul_ps(h0, sc), cut);
+      h1 = _mm256_blendv_ps(h1, _mm256_mul_ps(h1, sc), cut);
+      h2 = _mm256_blendv_ps(h2, _mm256_mul_ps(h2, sc), cut);
+    }
+    if (lim) {  // row3's guard: the same operations (std::max(a, b) = max_ps(b, a))
+      const __m256 yh = _mm256_and_ps(
+          have, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, h0), _mm256_mul_ps(ky1, h1)), _mm256_mul_ps(ky2, h2)));
+      const __m256 bound = _mm256_max_ps(zero, _mm256_max_ps(_mm256_mul_ps(hfv, yh), _mm256_loadu_ps(lim + x)));
+      const __m256 yc = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, c0), _mm256_mul_ps(ky1, c1)), _mm256_mul_ps(ky2, c2));
+      const __m256 cut = _mm256_and_ps(finite, _mm256_cmp_ps(yc, bound, _CMP_GT_OQ));
+      const __m256 sc = _mm256_div_ps(bound, yc);
+      c0 = _mm256_blendv_ps(c0, _mm256_mul_ps(c0, sc), cut);
+      c1 = _mm256_blendv_ps(c1, _mm256_mul_ps(c1, sc), cut);
+      c2 = _mm256_blendv_ps(c2, _mm256_mul_ps(c2, sc), cut);
+    }
     // Finite with history: blend; finite without: the new value (count 1); non-finite:
     // the history (or 0, count 0).
-    const __m256 wn = _mm256_max_ps(afv, _mm256_div_ps(one, _mm256_add_ps(n, one)));  // std::max(1/(n+1), af)
+    const __m256 afx = afl ? _mm256_max_ps(_mm256_loadu_ps(afl + x), afv) : afv;  // std::max(af, afl)
+    const __m256 wn = _mm256_max_ps(afx, _mm256_div_ps(one, _mm256_add_ps(n, one)));  // std::max(1/(n+1), af)
     const __m256 blend = _mm256_and_ps(finite, have), fresh = _mm256_andnot_ps(have, finite);
     const __m256 o0 = _mm256_blendv_ps(_mm256_blendv_ps(h0, c0, fresh), _mm256_add_ps(h0, _mm256_mul_ps(wn, _mm256_sub_ps(c0, h0))), blend);
     const __m256 o1 = _mm256_blendv_ps(_mm256_blendv_ps(h1, c1, fresh), _mm256_add_ps(h1, _mm256_mul_ps(wn, _mm256_sub_ps(c1, h1))), blend);
@@ -214,27 +268,29 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
     _mm256_storeu_ps(ncount + x, nc);
     store_rgb8(orow + std::size_t(x) * 3, o0, o1, o2);
   }
-  row3(y, r, crow_all, hist, hcount, af, w, orow, ncount, x);
+  row3(y, r, crow_all, hist, hcount, af, w, orow, ncount, g, x);
 }
 
 #endif
 
 }  // namespace
 
-void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current, double alpha) {
+void AccumulationBuffer::row(int y, const Reprojection& r, const Image& current, double alpha,
+                             const AccumulationGuards& g) {
   const int w = current.width(), h = current.height(), ch = current.channels();
   if (ch == 3) {
 #ifdef MCR_ACC_AVX2
     if (isa_at_least(Isa::Avx2)) {
       row3_avx2(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha),
-                w, next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
+                w, next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w), g);
       return;
     }
 #endif
     row3(y, r, current.data(), usable_ ? value_.data() : nullptr, usable_ ? count_.data() : nullptr, float(alpha), w,
-         next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w));
+         next_.data() + std::size_t(y) * std::size_t(w) * 3, next_count_.data() + std::size_t(y) * std::size_t(w), g);
     return;
   }
+  if (g.any()) throw Error(Errc::Internal, "accumulation: guards need 3 channels");
   const float* hist = usable_ ? value_.data() : nullptr;
   const float* hcount = usable_ ? count_.data() : nullptr;
   const float af = float(alpha);
@@ -304,9 +360,10 @@ void AccumulationBuffer::finish() {
   std::swap(count_, next_count_);
 }
 
-const Image& AccumulationBuffer::accumulate(const Reprojection& r, const Image& current, double alpha, int nthreads) {
+const Image& AccumulationBuffer::accumulate(const Reprojection& r, const Image& current, double alpha, int nthreads,
+                                            const AccumulationGuards& guards) {
   begin(r, current);
-  parallel_rows(0, current.height(), nthreads, [&](int y) { row(y, r, current, alpha); });
+  parallel_rows(0, current.height(), nthreads, [&](int y) { row(y, r, current, alpha, guards); });
   finish();
   return value_;
 }
@@ -358,13 +415,13 @@ const Image& TemporalAccumulator::accumulate(const Image& colour, const Image& p
   parallel_rows(0, h, nthreads, [&](int y) {
     if (before_row_) (*before_row_)(y);
     row_lost_[std::size_t(y)] = geometry_.row(y, position, normal, motion, params_.reprojection, r);
-    buffer_.row(y, r, colour, params_.alpha);
+    buffer_.row(y, r, colour, params_.alpha, guards_);
   });
   std::size_t lost = 0;
   for (std::size_t v : row_lost_) lost += v;
   if (geometry_.finish(params_.reprojection, r, lost)) {
     buffer_.begin(r, colour);
-    parallel_rows(0, h, nthreads, [&](int y) { buffer_.row(y, r, colour, params_.alpha); });
+    parallel_rows(0, h, nthreads, [&](int y) { buffer_.row(y, r, colour, params_.alpha, guards_); });
   }
   buffer_.finish();
   return buffer_.value();

@@ -6,6 +6,15 @@
 // count rounded to the nearest integer, plus one) until that weight would fall below
 // alpha, then by an exponential moving average of weight alpha.
 //
+// Guards (optional, per pixel, AccumulationGuards below) act on the new value before the
+// blend: its luminance is cut to max(limit, history_factor x the history's luminance, 0),
+// RGB scaled alike (a firefly that neither its neighbours nor its own history back is cut
+// to what they do back; a highlight that persists is not), and its weight is at least
+// alpha_floor (a pixel whose history cannot be trusted, such as a mirror whose reflection
+// does not move with the surface, keeps a short one). Where alpha_floor exceeds alpha and
+// limit is given, the history itself is first cut to max(limit, 0) the same way (a
+// reflection that has slid away fades at once, as TAA clips its history).
+//
 // Non-finite input: a pixel whose new value has a NaN/Inf channel keeps its history
 // (count unchanged); with no history it is marked invalid (count 0, value 0), and
 // invalid history taps are never read.
@@ -17,12 +26,20 @@
 
 namespace mcr {
 
+struct AccumulationGuards {
+  const float* limit = nullptr;        // w x h luminance bounds (prepare/sample_limits.h), or none
+  const float* alpha_floor = nullptr;  // w x h, or none
+  float history_factor = 4.0f;
+  bool any() const { return limit || alpha_floor; }
+};
+
 // One accumulated quantity (any channel count <= 8) with its per-pixel sample count.
 class AccumulationBuffer {
  public:
   // Blends `current` with the history reprojected by `r` (same size) and keeps the
   // result (and the counts) as the new history; returns it (valid until the next call).
-  const Image& accumulate(const Reprojection& r, const Image& current, double alpha, int nthreads);
+  const Image& accumulate(const Reprojection& r, const Image& current, double alpha, int nthreads,
+                          const AccumulationGuards& guards = {});
   void reset();
   const Image& value() const { return value_; }
   const std::vector<float>& count() const { return count_; }  // 0 = invalid pixel
@@ -32,7 +49,7 @@ class AccumulationBuffer {
   // usable with `r`; row(y) blends row y (r's row y must be final); finish() makes the
   // target the new history. begin() may be called again before finish() to redo a frame.
   void begin(const Reprojection& r, const Image& current);
-  void row(int y, const Reprojection& r, const Image& current, double alpha);
+  void row(int y, const Reprojection& r, const Image& current, double alpha, const AccumulationGuards& guards = {});
   void finish();
   // The target of the pending begin()/row() calls (the history-to-be).
   const Image& pending() const { return next_; }
@@ -67,12 +84,18 @@ class TemporalAccumulator {
   const Image& accumulate(const Frame& frame, const Image& colour, const std::function<void(int)>& before_row,
                           int nthreads);
 
+  // Guards for the following accumulate() calls (the arrays must stay valid and sized to
+  // the frames); clear_guards() drops them.
+  void set_guards(const AccumulationGuards& g) { guards_ = g; }
+  void clear_guards() { guards_ = {}; }
+
   const Reprojection& last_reprojection() const { return reprojection_; }
   const std::vector<float>& sample_count() const { return buffer_.count(); }
   void reset();
 
  private:
   AccumulationParams params_;
+  AccumulationGuards guards_;
   GeometryHistory geometry_;
   AccumulationBuffer buffer_;
   Reprojection reprojection_;

@@ -8,6 +8,8 @@
 #include <ctime>
 
 #include "prepare/demodulation.h"
+#include "prepare/sample_limits.h"
+#include "prepare/surface_classes.h"
 #include "util/avx2_shuffles.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -58,6 +60,15 @@ const FilterInfo& BmfrFilter::static_info() {
                          "stochastic regularisation: uniform noise in [-epsilon, epsilon] added to the fitted features"),
         ParamSpec::Float("alpha1", 0.2, 0.01, 1.0, "phase I: weight floor of the new noisy sample (cumulative average until then)"),
         ParamSpec::Float("alpha2", 0.1, 0.01, 1.0, "phase III: weight floor of the new fitted frame"),
+        ParamSpec::Float("sample_limit_k", 3.0, 0.0, 1e3,
+                         "phase I: a new sample's luminance is cut to its neighbours' mean + this many standard deviations "
+                         "(prepare/sample_limits.h) unless its own history backs it (sample_limit_history); 0 = off"),
+        ParamSpec::Int("sample_limit_radius", 2, 1, 8, "half width of the sample limit's window"),
+        ParamSpec::Float("sample_limit_history", 4.0, 1.0, 1e6,
+                         "a sample up to this many times its history's luminance passes the sample limit"),
+        ParamSpec::Float("mirror_alpha", 0.5, 0.0, 1.0,
+                         "weight floor of the new sample on mirror-like pixels (Glossy Color > 10x Diffuse Color) in phases "
+                         "I and III; their phase I history is also cut to the sample limit"),
         ParamSpec::Enum("features", "default", {"default", "first_order", "with_albedo", "with_depth"},
                         "feature set: default [1,n,w,w^2] (10), first_order [1,n,w] (7), with_albedo (+albedo, 13), "
                         "with_depth (+depth, 11)"),
@@ -77,10 +88,10 @@ const FilterInfo& BmfrFilter::static_info() {
         ParamSpec::Int("seed", 0, 0, 2147483647, "seed of the regularisation noise"),
         ParamSpec::Bool("albedo_demodulation", true,
                         "fit illumination = colour / max(albedo, albedo_floor) and multiply back before TAA (when an albedo "
-                        "pass exists)"),
+                        "pass exists); pixels whose albedo exceeds 1 (it holds light) are left out of the fit, mirror-like "
+                        "ones are not divided"),
         ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0,
-                         "albedo_demodulation raises the albedo to at least this (no upper clamp: Blender's albedo "
-                         "exceeds 1 on highlights)"),
+                         "albedo_demodulation raises the albedo to at least this"),
         ParamSpec::Enum("position_test", "relative", {"relative", "absolute"},
                         "history discard by world distance: relative = in pixel footprints, absolute = world units"),
         ParamSpec::Float("position_threshold", 3.0, 0.0, 1e9, "history tap kept when its world distance is at most this"),
@@ -115,6 +126,8 @@ std::vector<std::string> BmfrFilter::own_unused() const {
   for (const char* name : {"taa_alpha", "taa_clip", "taa_gamma", "taa_history"}) unused_when(!taa, name, "with taa=false", u);
   unused_when(taa && params_.get_enum("taa_clip") != "ycocg_variance", "taa_gamma", "with taa_clip=rgb_minmax", u);
   unused_when(!params_.get_bool("albedo_demodulation"), "albedo_floor", "with albedo_demodulation=false", u);
+  for (const char* name : {"sample_limit_radius", "sample_limit_history"})
+    unused_when(!(params_.get_float("sample_limit_k") > 0), name, "with sample_limit_k=0", u);
   return u;
 }
 
@@ -175,6 +188,7 @@ __attribute__((target("avx2"))) int remodulate_row_avx2(const float* s, const fl
 }
 
 #endif
+
 }  // namespace
 
 void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
@@ -184,8 +198,18 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   auto t0 = std::chrono::steady_clock::now();
   double c0 = cpu_now_ms();
 
-  // Albedo guard: [albedo_floor, inf) per channel, non-finite reads as 1.
   const std::size_t n = std::size_t(w) * h;
+  classify_surfaces(frame, nthreads, classes_);
+  if (!classes_.colour_passes && frame_index_ == 0)
+    note("bmfr: no Diffuse and Glossy Color passes: mirror-like surfaces are not told apart (their history is "
+         "reprojected with the surface)");
+  if (classes_.light_in_albedo)
+    note("bmfr: " + std::to_string(classes_.light_in_albedo) + " pixels whose albedo exceeds 1 (it holds light) kept "
+         "their own accumulated value, out of the fit");
+  if (classes_.mirror)
+    note("bmfr: " + std::to_string(classes_.mirror) + " mirror-like pixels (Glossy Color > " +
+         rounded_text(kMirrorRatio, 3) + "x Diffuse Color): not demodulated, out of the fit, history weight at least "
+         "mirror_alpha and cut to the sample limit");
   const Pass* ap = frame.find(Role::Albedo);
   const bool demod = params_.get_bool("albedo_demodulation") && ap;
   if (params_.get_bool("albedo_demodulation") && !ap) note("no albedo pass: the colour is fitted without demodulation");
@@ -197,13 +221,44 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     ensure_image(albedo_, w, h, 3);
     const float lo = float(params_.get_float("albedo_floor"));
     const Image& ai = ap->image;
+    // No ceiling: a pixel whose albedo holds light is divided by it (its light explained)
+    // and left out of the fit below. A mirror is not divided at all.
     demod_row = [&, lo](int y) {
-      demodulate_row(ai.pixel(0, y), ai.channels(), colour.pixel(0, y), w, lo, albedo_.pixel(0, y), illum_.pixel(0, y));
+      demodulate_row(ai.pixel(0, y), ai.channels(), colour.pixel(0, y), w, lo, albedo_.pixel(0, y), illum_.pixel(0, y),
+                     std::numeric_limits<float>::infinity());
+      if (!classes_.mirror) return;
+      const std::uint8_t* f = classes_.flags.data() + std::size_t(y) * std::size_t(w);
+      for (int x = 0; x < w; ++x)
+        if (f[x] & SurfaceClasses::kMirror)
+          for (int c = 0; c < 3; ++c) {
+            albedo_.at(x, y, c) = 1.0f;
+            illum_.at(x, y, c) = colour.at(x, y, c);
+          }
     };
   }
 
-  // Phase I (reprojection fused with the accumulation).
-  const Image& acc1 = demod ? phase1_.accumulate(frame, illum_, demod_row, nthreads) : phase1_.accumulate(frame, colour, nthreads);
+  // Phase I (reprojection fused with the accumulation), with its guards
+  // (temporal/accumulation.h): the sample limit needs the new illumination whole first
+  // (its windows), so the demodulation then runs ahead.
+  const double limit_k = params_.get_float("sample_limit_k");
+  AccumulationGuards guards;
+  if (limit_k > 0) {
+    if (demod) parallel_rows(0, h, nthreads, demod_row);
+    firefly_limits(demod ? illum_ : colour, int(params_.get_int("sample_limit_radius")), limit_k, nthreads, limit_);
+    guards.limit = limit_.data();
+    guards.history_factor = float(params_.get_float("sample_limit_history"));
+  }
+  if (classes_.mirror) {
+    const float a = float(params_.get_float("mirror_alpha"));
+    alpha_floor_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) alpha_floor_[i] = (classes_.flags[i] & SurfaceClasses::kMirror) ? a : 0.0f;
+    guards.alpha_floor = alpha_floor_.data();
+  }
+  phase1_.set_guards(guards);
+  const Image& acc1 = demod ? (limit_k > 0 ? phase1_.accumulate(frame, illum_, nthreads)
+                                           : phase1_.accumulate(frame, illum_, demod_row, nthreads))
+                            : phase1_.accumulate(frame, colour, nthreads);
+  phase1_.clear_guards();
   const Reprojection& rep = phase1_.last_reprojection();
   last_cut_ = rep.cut;
   if (rep.cut) note("camera cut: " + std::to_string(rep.discarded) + " of " + std::to_string(n) + " pixels lost their history; restarted");
@@ -218,7 +273,19 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   t0 = std::chrono::steady_clock::now();
   c0 = cpu_now_ms();
   ensure_image(fitted_, w, h, 3);
-  fit_blocks(frame, acc1, phase1_.sample_count(), fitted_, nthreads);
+  const std::vector<float>& counts = phase1_.sample_count();
+  if (classes_.any()) {
+    // Pixels whose albedo holds light, and mirrors, are left out of the fit (it would
+    // spread their light over the block) and keep their own accumulated illumination.
+    fit_valid_.resize(n);
+    for (std::size_t i = 0; i < n; ++i) fit_valid_[i] = classes_.flags[i] ? 0.0f : counts[i];
+  }
+  fit_blocks(frame, acc1, classes_.any() ? fit_valid_ : counts, fitted_, nthreads);
+  if (classes_.any())
+    parallel_rows(0, h, nthreads, [&](int y) {
+      for (std::size_t i = std::size_t(y) * std::size_t(w), e = i + std::size_t(w); i < e; ++i)
+        if (classes_.flags[i] && counts[i] > 0.0f) std::copy(acc1.data() + 3 * i, acc1.data() + 3 * i + 3, fitted_.data() + 3 * i);
+    });
   stage_ms_[kFit] = ms_since(t0);
   stage_cpu_ms_[kFit] = cpu_now_ms() - c0;
 
@@ -231,9 +298,11 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   const bool hist = use_taa && taa_w_ == w && taa_h_ == h && taa_hist_.size() == 3 * n && rep.has_history && !rep.cut;
   const double alpha2 = params_.get_float("alpha2");
   res_.resize(3 * n);
+  AccumulationGuards phase3_guards;  // mirrors keep a short history here too
+  phase3_guards.alpha_floor = guards.alpha_floor;
   phase3_.begin(rep, fitted_);
   parallel_rows(0, h, nthreads, [&](int y) {
-    phase3_.row(y, rep, fitted_, alpha2);
+    phase3_.row(y, rep, fitted_, alpha2, phase3_guards);
     const std::size_t rb = std::size_t(y) * std::size_t(w);
     const float* s = phase3_.pending().data() + rb * 3;
     const float* a = demod ? albedo_.data() + rb * 3 : nullptr;

@@ -3,6 +3,7 @@
 #include <cstdint>
 
 #include "filters/filter.h"
+#include "prepare/surface_classes.h"
 #include "temporal/accumulation.h"
 
 namespace mcr {
@@ -27,6 +28,15 @@ namespace mcr {
 // pixels at a time (temporal/*_avx2, bmfr_taa, bmfr_fit, bmfr_fit_features); they do the
 // float operations of the scalar loops in the same order without FMA, so both builds give
 // the same bits.
+// Highlights and mirrors (issue 15; prepare/surface_classes.h, temporal/accumulation.h):
+//   - phase I's new sample is cut to its neighbours' mean + sample_limit_k deviations
+//     unless its own history backs it (a firefly does not enter the history);
+//   - a pixel whose albedo holds light (> 1) is divided by it but left out of the fit
+//     (which would spread its light over the block) and keeps its accumulated value;
+//   - a mirror-like pixel (Glossy Color >> Diffuse Color) is not divided by its albedo
+//     (the albedo of what it reflects, sample by sample), is left out of the fit, and
+//     keeps a short history (weight >= mirror_alpha, cut to the sample limit): what it
+//     shows does not move with its surface.
 // Temporal: history lives in the object; reset() drops it. A size change or a camera
 // cut (more than cut_fraction of the pixels lose every reprojection tap) restarts it.
 // The whole frame is always processed (history needs it); only the roi is written.
@@ -72,6 +82,8 @@ class BmfrFilter : public Filter {
   AccumulationBuffer phase3_;
   // Per-frame work buffers, kept between frames so that a steady sequence allocates nothing.
   Image illum_, albedo_, fitted_;
+  std::vector<float> fit_valid_;
+  std::vector<float> limit_;               // phase I's sample limits (prepare/sample_limits.h)           // phase I's counts, 0 where the albedo holds light
   std::vector<float> res_;                 // phase III result (remodulated), planar RGB
   std::vector<float> taa_hist_, taa_next_;  // TAA history (the previous output), planar RGB
   int taa_w_ = 0, taa_h_ = 0;              // size of taa_hist_ (0: none)

@@ -1,0 +1,24 @@
+#pragma once
+// How bright a new sample may be before it enters a temporal history (issue 15: a 1-spp
+// sample of 300 entered at weight 1 or 0.2 and stayed for frames).
+//
+// Per pixel p, over the other pixels q of its (2 radius + 1)^2 window clipped at the image
+// (centre excluded) whose three channels are finite, n of them:
+//   limit(p) = mu + max(k sd, 0.01 |mu|)      (n >= 3; +inf below)
+// with mu, sd the mean and population deviation of their luminance: the bound of the
+// outlier rule in prepare/outliers.h, so a firefly is cut to what its neighbours back,
+// and a highlight several pixels wide (its neighbours bright too) is left alone. The
+// accumulation (temporal/accumulation.h) lets a sample through above this when its own
+// history backs it. Sums in double from window sums (kernels/window_sums.h): the
+// variance as E[Y^2] - mu^2 loses only what a bound cannot notice (sd below 1e-8 mu).
+#include <vector>
+
+#include "image/image.h"
+
+namespace mcr {
+
+// limit: one float per pixel of rgb (resized), +inf where the window has fewer than 3
+// finite neighbours, the largest float where the bound would overflow.
+void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit);
+
+}  // namespace mcr

@@ -1,0 +1,37 @@
+#pragma once
+// What a pixel's passes say about how far its demodulation and its history can be
+// trusted (issue 15: bmfr 6x worse than its input on metal under a sun).
+//
+//   light_in_albedo: an albedo channel above 1. A reflectance is at most 1: the pass
+//     holds light (Blender's Denoising Albedo follows a mirror's bounce; where that
+//     sample hit the sun it reads ~200, the next sample 0.4).
+//   mirror: the Glossy Color pass exceeds kMirrorRatio x the Diffuse Color pass and
+//     kMirrorGloss (a metal: all its light comes by reflection). Its Denoising Albedo is
+//     the albedo of whatever it reflects, sample by sample, so colour / albedo swings; and
+//     what it shows does not move with its surface, so a history reprojected with the
+//     surface trails (the sun's reflection slides over a sphere as the camera moves).
+//     Needs both colour passes (Blender: Diffuse Color, Glossy Color); without them no
+//     pixel is called a mirror and the notes say so.
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include "image/pass.h"
+
+namespace mcr {
+
+constexpr float kMirrorRatio = 10.0f;
+constexpr float kMirrorGloss = 0.02f;
+
+struct SurfaceClasses {
+  enum : std::uint8_t { kLightInAlbedo = 1, kMirror = 2 };
+  std::vector<std::uint8_t> flags;  // per pixel, 0 = neither
+  std::size_t light_in_albedo = 0, mirror = 0;
+  bool colour_passes = false;  // Diffuse and Glossy Color present: mirrors detectable
+  bool any() const { return light_in_albedo + mirror > 0; }
+};
+
+// Flags of every pixel of `frame` (a non-finite value never sets a flag).
+void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out);
+
+}  // namespace mcr
