@@ -12,6 +12,9 @@ between successive levels (about 4 for 4x the samples). Half buffers (`halves`: 
 renders with the level's seed and sample offsets 0 and spp/2) must average to the level's file
 in every pass Cycles accumulates; Depth and Position, which Cycles writes on sample 0 only, must
 be the level's in half 0 and unwritten (Depth 1e10, Position 0) in half 1.
+A scene with `light_passes` must carry them in every noisy file, and they must sum to Combined:
+(DiffDir+DiffInd)*DiffCol + (GlossDir+GlossInd)*GlossCol + (TransDir+TransInd)*TransCol + Emit
++ Env, up to half-float rounding.
 Exit status 1 on any failure.
 """
 import argparse
@@ -112,6 +115,31 @@ def check_halves(data, sc, spp, files):
           f"half 1 has no Depth/Position (Cycles writes them on sample 0 only)")
 
 
+def light_sum(names, pix):
+    """Blender's light passes recombined into the beauty, and the sum of the terms' magnitudes
+    (what half-float rounding of the stored terms scales with)."""
+    def g(p):
+        return pix[..., [names.index(f"ViewLayer.{p}.{c}") for c in "RGB"]]
+    terms = [(g(f"{k}Dir") + g(f"{k}Ind")) * g(f"{k}Col") for k in ("Diff", "Gloss", "Trans")]
+    terms += [g("Emit"), g("Env")]
+    scale = sum(np.abs(g(f"{k}Dir")) + np.abs(g(f"{k}Ind")) for k in ("Diff", "Gloss", "Trans"))
+    return sum(terms), scale + np.abs(g("Emit")) + np.abs(g("Env"))
+
+
+def check_light_passes(path, names, pix):
+    """The light passes must sum to Combined; returns the worst relative difference."""
+    got, scale = light_sum(names, pix)
+    want = combined(names, pix)
+    d = np.abs(got - want)
+    # Every stored term and Combined are rounded to half (relative 2^-11); products and sums of
+    # up to 9 such terms: allow 2^-8 of the magnitudes involved.
+    tol = 2.0 ** -8 * (scale + np.abs(want)) + 1e-5
+    if (d > tol).any():
+        fail(f"{path}: light passes do not sum to Combined at {int((d > tol).any(axis=2).sum())} "
+             f"pixels (up to {float(d.max()):.3g})")
+    return float((d / np.maximum(np.abs(want), 1e-3)).max()), float(d.max())
+
+
 def frame_paths(data, pattern, frames):
     return [(f, os.path.join(data, pattern.replace("####", f"{f:04d}")))
             for f in range(frames[0], frames[1] + 1)]
@@ -147,7 +175,7 @@ def main():
                 if args.png and f in (None, frames[0]):
                     png(path, args.png)
         for spp, pat in sorted(sc["noisy"].items(), key=lambda kv: int(kv[0])):
-            errs, vec = [], []
+            errs, vec, light = [], [], []
             for f, path in (frame_paths(args.data, pat, frames) if seq
                             else [(None, os.path.join(args.data, pat))]):
                 names, pix = check_file(path, sc["noisy_passes"])
@@ -157,6 +185,8 @@ def main():
                 if names[:4] != RGB + ["ViewLayer.Combined.A"]:
                     fail(f"{path}: unexpected channel order {names[:4]}")
                 errs.append(rel_mse(combined(names, pix), refs[f]))
+                if sc.get("light_passes"):
+                    light.append(check_light_passes(path, names, pix))
                 if seq:
                     vx = np.abs(pix[..., names.index("ViewLayer.Vector.X")]).mean()
                     vy = np.abs(pix[..., names.index("ViewLayer.Vector.Y")]).mean()
@@ -166,6 +196,10 @@ def main():
                 if args.png and f in (None, frames[0]) and int(spp) <= 4:
                     png(path, args.png)
             table.append((name, int(spp), float(np.mean(errs)), len(errs)))
+            if light:
+                print(f"{name}: {spp}-spp light passes sum to Combined up to "
+                      f"{max(v[1] for v in light):.3g} (relative {max(v[0] for v in light):.2g}) "
+                      f"in {len(light)} file(s)")
             if spp in sc.get("halves", {}):
                 for f in sc["halves"][spp]:
                     total_bytes += os.path.getsize(os.path.join(args.data, f))

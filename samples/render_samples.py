@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """Render mcrecon's sample scenes with Blender (Cycles, CPU) and write samples/data/manifest.json.
 
-    python3 samples/render_samples.py                       # everything (~25 min on 2 idle cores)
+    python3 samples/render_samples.py                       # everything (~35 min on 2 idle cores)
     python3 samples/render_samples.py --scenes room,dof     # some scenes (manifest entries merged)
     python3 samples/render_samples.py --spp 1,4 --ref-spp 256 --out /tmp/quick   # quick look
 
@@ -39,11 +39,16 @@ SCENES = {
     "wall": ("still", "A flat plastered brick wall filling the frame, seen straight on by an "
                       "orthographic camera (constant Normal and Depth passes), grazing area light "
                       "and the soft shadow of a pole outside the view; no depth of field."),
+    "metal": ("sequence", "16-frame keyframed camera orbit (3 degrees per frame) around a polished "
+                          "gold sphere that mirrors a small, strong sun (the reflection slides "
+                          "over it), a brushed-steel torus and a glass ball on a glossy checkered "
+                          "floor before a low brick wall; indirect clamp off (fireflies); the "
+                          "noisy frames carry Blender's light passes."),
 }
-ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall"]
+ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
-         "sunlit": "report", "showroom": "report", "wall": "report"}
+         "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
 HALVES = {"sunlit": [16], "showroom": [16], "wall": [16]}
 
@@ -68,6 +73,9 @@ def parse_args():
     p.add_argument("--frames", default="1-16", help="animation frame range")
     p.add_argument("--still-size", default="256x192", help="WxH of the stills")
     p.add_argument("--anim-size", default="320x180", help="WxH of the animation")
+    p.add_argument("--metal-size", default="256x144", help="WxH of the metal sequence")
+    p.add_argument("--metal-ref-spp", type=int, default=512,
+                   help="reference spp per frame of the metal sequence")
     p.add_argument("--threads", type=int, default=0, help="Cycles threads (0 = all cores)")
     p.add_argument("--blender", default=os.environ.get("BLENDER", "blender"))
     return p.parse_args()
@@ -79,13 +87,19 @@ def blender_version(blender):
     return first.replace("Blender", "").strip()
 
 
+def seq_settings(args, name):
+    """(WxH, reference spp) of a sequence: each has its own options."""
+    if name == "metal":
+        return args.metal_size, args.metal_ref_spp
+    return args.anim_size, args.anim_ref_spp
+
+
 def run_scene(args, name, counter, total):
     kind, _ = SCENES[name]
     seq = kind == "sequence"
-    size = args.anim_size if seq else args.still_size
+    size, ref = seq_settings(args, name) if seq else (args.still_size, args.ref_spp)
     w, h = (int(v) for v in size.lower().split("x"))
     spp = args.anim_spp if seq else args.spp
-    ref = args.anim_ref_spp if seq else args.ref_spp
     out_dir = os.path.join(args.out, name)
     os.makedirs(out_dir, exist_ok=True)
     cmd = [args.blender, "-b", "--factory-startup", "--python-exit-code", "1",
@@ -163,7 +177,11 @@ def manifest_entry(name, records, info, wall, out_root):
         e["frames"] = info["frames"]
         e["fps"] = info["fps"]
     e["noisy"] = {str(s): pattern(s) for s in noisy}
-    e["noisy_passes"] = NOISY_PASSES
+    light = info.get("light_passes", [])
+    # Blender writes the passes in alphabetical order; DiffCol and GlossCol are in both lists.
+    e["noisy_passes"] = sorted(set(NOISY_PASSES) | set(light)) if light else NOISY_PASSES
+    if light:
+        e["light_passes"] = light
     if halves:
         e["halves"] = {str(s): [rel(r["file"]) for r in halves if r["of_spp"] == s]
                        for s in sorted({r["of_spp"] for r in halves})}
@@ -204,7 +222,7 @@ def main():
     total = 0
     for n in names:
         if SCENES[n][0] == "sequence":
-            total += nframes * (len(args.anim_spp) + (args.anim_ref_spp > 0))
+            total += nframes * (len(args.anim_spp) + (seq_settings(args, n)[1] > 0))
         else:
             total += len(args.spp) + (args.ref_spp > 0) + \
                 2 * len([h for h in HALVES.get(n, []) if h in args.spp])

@@ -164,13 +164,28 @@ def configure_render(scene, width, height, threads=0, clamp_indirect=CLAMP_INDIR
     return vl
 
 
-def set_passes(view_layer, all_passes):
-    """All passes for noisy renders; only Combined for references (unless asked otherwise)."""
+# Blender's light passes (channel names in the EXR), enabled by set_passes(light_passes=True).
+# Combined = (DiffDir+DiffInd)*DiffCol + (GlossDir+GlossInd)*GlossCol
+#          + (TransDir+TransInd)*TransCol + Emit + Env   (no volumes in the scenes)
+LIGHT_PASSES = ["DiffDir", "DiffInd", "DiffCol", "GlossDir", "GlossInd", "GlossCol",
+                "TransDir", "TransInd", "TransCol", "Emit", "Env"]
+
+
+def set_passes(view_layer, all_passes, light_passes=False):
+    """All passes for noisy renders; only Combined for references (unless asked otherwise).
+    `light_passes` adds Blender's light passes (LIGHT_PASSES) to a render with all passes."""
     view_layer.use_pass_combined = True
     for attr in ("use_pass_z", "use_pass_normal", "use_pass_position", "use_pass_vector",
                  "use_pass_diffuse_color", "use_pass_glossy_color"):
         setattr(view_layer, attr, all_passes)
     view_layer.cycles.denoising_store_passes = all_passes
+    light = all_passes and light_passes
+    for comp in ("diffuse", "glossy", "transmission"):
+        for part in ("direct", "indirect"):
+            setattr(view_layer, f"use_pass_{comp}_{part}", light)
+    view_layer.use_pass_transmission_color = light
+    view_layer.use_pass_emit = light
+    view_layer.use_pass_environment = light
 
 
 # --------------------------------------------------------------------------- materials
@@ -536,11 +551,12 @@ def _emit(record):
     print("MCRECON_FILE " + json.dumps(record), flush=True)
 
 
-def _render_one(scene, view_layer, path, spp, seed, all_passes, sample_offset=0):
+def _render_one(scene, view_layer, path, spp, seed, all_passes, sample_offset=0,
+                light_passes=False):
     scene.cycles.samples = spp
     scene.cycles.seed = seed
     scene.cycles.sample_offset = sample_offset
-    set_passes(view_layer, all_passes)
+    set_passes(view_layer, all_passes, light_passes)
     scene.render.filepath = path
     t0 = time.perf_counter()
     bpy.ops.render.render(write_still=True)
@@ -550,9 +566,11 @@ def _render_one(scene, view_layer, path, spp, seed, all_passes, sample_offset=0)
     return dt
 
 
-def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT):
+def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT, light_passes=False):
     """Render the noisy levels and the reference of a still, or of every frame of a sequence.
 
+    `light_passes`: the noisy renders (and a reference with all passes) also carry Blender's
+    light passes (LIGHT_PASSES); the other scenes leave it off, so their files do not change.
     A still's level listed in args.halves is also written as two half buffers: spp/2 samples
     each with the level's own seed and sample offsets 0 and spp/2, so that their mean is the
     level's file (the same samples, split in two)."""
@@ -574,12 +592,13 @@ def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT):
         for kind, spp, all_passes in jobs:
             name = f"{scene_name}_{spp}spp.exr" if kind == "noisy" else f"{scene_name}_ref.exr"
             seed = seed_for(scene_name, kind, spp)
-            dt = _render_one(scene, view_layer, os.path.join(out, name), spp, seed, all_passes)
+            dt = _render_one(scene, view_layer, os.path.join(out, name), spp, seed, all_passes,
+                             light_passes=light_passes)
             _emit({"scene": scene_name, "file": name, "kind": kind, "spp": spp, "seed": seed,
                    "frame": None, "seconds": round(dt, 3), "all_passes": all_passes})
             if kind == "noisy" and spp in args.halves:
-                _render_halves(scene, view_layer, out, scene_name, spp, seed)
-        _emit_info(info, clamp_indirect)
+                _render_halves(scene, view_layer, out, scene_name, spp, seed, light_passes)
+        _emit_info(info, clamp_indirect, light_passes)
         return
 
     f0, f1 = args.frames
@@ -593,29 +612,32 @@ def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT):
             stem = f"{scene_name}_{spp}spp" if kind == "noisy" else f"{scene_name}_ref"
             name = f"{stem}_{frame:04d}.exr"
             seed = seed_for(scene_name, kind, spp, frame)
-            dt = _render_one(scene, view_layer, os.path.join(out, name), spp, seed, all_passes)
+            dt = _render_one(scene, view_layer, os.path.join(out, name), spp, seed, all_passes,
+                             light_passes=light_passes)
             _emit({"scene": scene_name, "file": name, "kind": kind, "spp": spp, "seed": seed,
                    "frame": frame, "seconds": round(dt, 3), "all_passes": all_passes})
     _emit_info({"scene": scene_name, "width": args.width, "height": args.height,
                 "frames": [f0, f1], "fps": scene.render.fps,
-                "camera": {str(k): v for k, v in cams.items()}}, clamp_indirect)
+                "camera": {str(k): v for k, v in cams.items()}}, clamp_indirect, light_passes)
 
 
-def _render_halves(scene, view_layer, out, scene_name, spp, seed):
+def _render_halves(scene, view_layer, out, scene_name, spp, seed, light_passes=False):
     if spp % 2:
         raise ValueError(f"--halves: {spp} spp cannot be split in two equal halves")
     half = spp // 2
     for i in (0, 1):
         name = f"{scene_name}_{spp}spp_half{i}.exr"
         dt = _render_one(scene, view_layer, os.path.join(out, name), half, seed, True,
-                         sample_offset=i * half)
+                         sample_offset=i * half, light_passes=light_passes)
         _emit({"scene": scene_name, "file": name, "kind": "half", "spp": half, "of_spp": spp,
                "half": i, "sample_offset": i * half, "seed": seed, "frame": None,
                "seconds": round(dt, 3), "all_passes": True})
     scene.cycles.sample_offset = 0
 
 
-def _emit_info(info, clamp_indirect):
+def _emit_info(info, clamp_indirect, light_passes=False):
+    if light_passes:
+        info["light_passes"] = LIGHT_PASSES
     info["blender_version"] = bpy.app.version_string
     info["cycles"] = {"device": "CPU", "denoising": False, "adaptive_sampling": False,
                       "clamp_indirect": clamp_indirect, "max_bounces": MAX_BOUNCES,
