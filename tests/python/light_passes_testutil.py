@@ -65,10 +65,12 @@ def write_multilayer(path, passes, leave_out=()):
 
 
 def write_single(path, rgb, passes):
-    """A plain file whose Combined is `rgb`, with the same feature passes: the oracle's input."""
-    tu.write_exr(path, np.concatenate([rgb, passes["Normal"], passes["Depth"]], axis=-1),
+    """A file whose Combined is `rgb`, with the same feature passes (DiffCol: the albedo the
+    multilayer file's filters see): the oracle's input."""
+    tu.write_exr(path, np.concatenate([rgb, passes["Normal"], passes["Depth"], passes["DiffCol"]], axis=-1),
                  ["%s.Combined.%s" % (LAYER, c) for c in "RGB"] +
-                 ["%s.Normal.%s" % (LAYER, c) for c in "XYZ"] + [LAYER + ".Depth.Z"])
+                 ["%s.Normal.%s" % (LAYER, c) for c in "XYZ"] + [LAYER + ".Depth.Z"] +
+                 ["%s.DiffCol.%s" % (LAYER, c) for c in "RGB"])
 
 
 def component_layer_channels(name, layer=LAYER):
