@@ -60,6 +60,18 @@ bool uses_light_passes(const ParamSet& params) {
   return params.has("components") && params.get_enum("components") == "light_passes";
 }
 
+void check_keep_components(const ParamSet& params) {
+  if (uses_light_passes(params)) return;
+  throw Error(Errc::InvalidArgument,
+              "keep_components (--keep-components) writes the denoised light components and needs "
+              "components=light_passes (the filter runs with components=" +
+                  (params.has("components") ? params.get_enum("components") : std::string("beauty")) + ")");
+}
+
+std::string component_layer_prefix(const std::string& layer) {
+  return layer.empty() ? "Denoised." : layer + ".Denoised.";
+}
+
 std::vector<Role> light_pass_roles() {
   std::vector<Role> roles;
   for (const LightComponent& c : light_components())

@@ -35,6 +35,14 @@ const std::vector<std::string>& component_layer_names();
 // components=light_passes in these settings (false for a table without the parameter).
 bool uses_light_passes(const ParamSet& params);
 
+// keep_components (--keep-components) asked for under these settings: throws
+// InvalidArgument unless components=light_passes.
+void check_keep_components(const ParamSet& params);
+
+// "ViewLayer.Denoised." ("Denoised." for a plain file): the prefix of the component layers
+// keep_components writes ("ViewLayer.Denoised.Diffuse.R", ...).
+std::string component_layer_prefix(const std::string& layer);
+
 // Every light pass: the three components' direct, indirect and colour passes, emission,
 // environment.
 std::vector<Role> light_pass_roles();

@@ -27,10 +27,7 @@ DenoiseSession::DenoiseSession(const std::string& filter,
 
 StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
                                const WriteOptions& write, const ExecOptions& exec) {
-  if (write.keep_components && !reconstruction_.light_passes())
-    throw Error(Errc::InvalidArgument, "keep_components (--keep-components) writes the denoised light components and needs "
-                                       "components=light_passes (the filter runs with components=" +
-                                           reconstruction_.filter().params().get_enum("components") + ")");
+  if (write.keep_components) check_keep_components(reconstruction_.filter().params());
   if (!output.empty()) {
     // Every front end's file run passes here: the output is checked against every
     // input of the run (the render and any loose pass file) before anything is read.
@@ -63,10 +60,6 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     t.write_ms = ms_since(t0);
   }
   return t;
-}
-
-std::string component_layer_prefix(const std::string& layer) {
-  return layer.empty() ? "Denoised." : layer + ".Denoised.";
 }
 
 }  // namespace mcr

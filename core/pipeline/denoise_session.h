@@ -41,10 +41,6 @@ class DenoiseSession {
   Reconstruction reconstruction_;
 };
 
-// "ViewLayer.Denoised." ("Denoised." for a plain file): the prefix of the component layers
-// write.keep_components adds ("ViewLayer.Denoised.Diffuse.R", ...).
-std::string component_layer_prefix(const std::string& layer);
-
 // "key=value" -> pair; throws InvalidArgument.
 std::pair<std::string, std::string> parse_key_value(const std::string& text, const std::string& option);
 
