@@ -21,7 +21,7 @@ struct DenoiseArgs {
   std::string input, output, filter, layer, frames, region, compression = "zip";
   std::string half;  // the other half buffer (a pattern for sequences)
   std::vector<std::string> sets, passes;
-  bool keep_passes = false, timings = false, verbose = false, resume = false;
+  bool keep_passes = false, keep_components = false, timings = false, verbose = false, resume = false;
   bool accumulate = false;  // the accumulation stage before the filter
   int threads = 0;
 };
@@ -59,6 +59,7 @@ int run_denoise(const DenoiseArgs& a) {
   for (const auto& p : a.passes) ro.overrides.push_back(parse_pass_override(p));
   WriteOptions wo;
   wo.keep_passes = a.keep_passes;
+  wo.keep_components = a.keep_components;
   wo.compression = checked_exr_compression(a.compression);
   ExecOptions eo;
   eo.nthreads = a.threads;
@@ -180,6 +181,9 @@ Run add_denoise(CLI::App& app) {
   add_threads_option(app, a->threads);
   app.add_option("--compression", a->compression, "EXR compression of the output (zip, piz, none, ...)");
   app.add_flag("--keep-passes", a->keep_passes, "carry the input's other channels into the output");
+  app.add_flag("--keep-components", a->keep_components,
+               "with --set components=light_passes: write each denoised light component as its own float layer "
+               "(<layer>.Denoised.Diffuse, Glossy, Transmission, Emission, Environment), summing to R,G,B exactly");
   app.add_flag("--resume", a->resume, "skip frames whose output exists (temporal filters replay them without writing)");
   app.add_flag("--accumulate", a->accumulate,
                "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");

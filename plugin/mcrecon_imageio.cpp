@@ -113,6 +113,7 @@ void cache_result(const std::string& key, std::shared_ptr<const Result> r) {
 
 struct Filtered {
   mcr::Image rgb;
+  std::vector<mcr::ComponentImage> components;  // with r.keep_components: the light components
   std::string notes;  // mp::notes_text of the reconstruction's notes after the run
 };
 
@@ -123,7 +124,8 @@ Filtered run_filter(const mp::Request& r, const std::string& settings, const std
   auto lease = g_history.acquire(settings, frame_name, [&] { return mp::make_reconstruction(r); });
   try {
     Filtered f;
-    f.rgb = lease.reconstruction->run(frame, {});
+    if (r.keep_components) mcr::check_keep_components(lease.reconstruction->filter().params());
+    f.rgb = lease.reconstruction->run(frame, {}, r.keep_components ? &f.components : nullptr);
     f.notes = mp::notes_text(lease.reconstruction->notes());
     g_history.done();
     return f;
@@ -390,6 +392,8 @@ class McreconOutput final : public ImageOutput {
       wo.keep_passes = request_.keep_passes;
       wo.compression = request_.compression;
       wo.attributes = description(request_.filter, params_text_, filtered.notes);
+      for (const mcr::ComponentImage& c : filtered.components)
+        wo.layers.emplace_back(mcr::component_layer_prefix(frame.layer) + c.name, &c.rgb);
       mcr::write_result(name_, filtered.rgb, frame, wo);
       ok_ = true;
     } catch (const std::exception& e) {

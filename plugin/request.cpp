@@ -71,6 +71,8 @@ Request make_request(const std::string& source, const KeyValues& settings, bool 
       r.accumulate = parse_switch(key, value, source);
     } else if (output_side && key == "keep_passes") {
       r.keep_passes = parse_switch(key, value, source);
+    } else if (output_side && key == "keep_components") {
+      r.keep_components = parse_switch(key, value, source);
     } else if (output_side && key == "compression") {
       r.compression = checked_exr_compression(value);  // OIIO would write zip for a bad name
     } else {

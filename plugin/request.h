@@ -27,6 +27,7 @@ struct Request {
   ReadOptions read;     // layer= and ROLE= pass overrides
   bool accumulate = false;       // accumulation stage before the filter (the CLI's --accumulate)
   bool keep_passes = false;      // output side only (mcrecon:keep_passes)
+  bool keep_components = false;  // output side only (mcrecon:keep_components; needs components=light_passes)
   std::string compression = "zip";  // output side only (mcrecon:compression)
 };
 
@@ -38,8 +39,8 @@ std::pair<std::string, KeyValues> split_name(const std::string& name);
 // Builds a request from key=value settings, in order: first `config` (the
 // "mcrecon:" attributes of --iconfig or of the output spec, prefix removed), then
 // the name's query. Keys: filter, layer, a pass role (colour, albedo, normal, ...,
-// as the CLI's --pass ROLE=VALUE), accumulate (0, 1, true, false), keep_passes and
-// compression (output only), anything else is a parameter of the filter's table
+// as the CLI's --pass ROLE=VALUE), accumulate (0, 1, true, false), keep_passes,
+// keep_components and compression (output only), anything else is a parameter of the filter's table
 // (checked by the filter). Throws InvalidArgument (no filter, bad role value, bad
 // accumulate or keep_passes).
 Request make_request(const std::string& source, const KeyValues& settings, bool output_side);

@@ -64,9 +64,11 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
                         wm.progress_update(n)
                         print(f"mcrecon: [{n}/{total}] {o}", flush=True)
                     mc.denoise_sequence(src, out, self.frame_start, self.frame_end, self.filter, params,
-                                        progress=progress, accumulate=self.accumulate)
+                                        progress=progress, accumulate=self.accumulate,
+                                        keep_components=context.scene.mcrecon.keep_components)
                 else:
-                    t = mc.Session(self.filter, params, accumulate=self.accumulate).denoise_file(src, out)
+                    t = mc.Session(self.filter, params, accumulate=self.accumulate).denoise_file(
+                        src, out, keep_components=context.scene.mcrecon.keep_components)
                     print(f"mcrecon: {out} ({t['total_ms']:.0f} ms)", flush=True)
                     for note in t["notes"]:  # auto: its scores and choice
                         self.report({"INFO"}, f"mcrecon: {note}")

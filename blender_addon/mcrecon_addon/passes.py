@@ -11,6 +11,21 @@ ROLE_TOGGLES = {
     "depth": ("", "use_pass_z"),
     "motion": ("", "use_pass_vector"),
 }
+# Light passes (components=light_passes denoises them one by one): switched on when needed,
+# never off, since a compositor may read them.
+LIGHT_TOGGLES = {
+    "diffuse_direct": ("", "use_pass_diffuse_direct"),
+    "diffuse_indirect": ("", "use_pass_diffuse_indirect"),
+    "diffuse_colour": ("", "use_pass_diffuse_color"),
+    "glossy_direct": ("", "use_pass_glossy_direct"),
+    "glossy_indirect": ("", "use_pass_glossy_indirect"),
+    "glossy_colour": ("", "use_pass_glossy_color"),
+    "transmission_direct": ("", "use_pass_transmission_direct"),
+    "transmission_indirect": ("", "use_pass_transmission_indirect"),
+    "transmission_colour": ("", "use_pass_transmission_color"),
+    "emission": ("", "use_pass_emit"),
+    "environment": ("", "use_pass_environment"),
+}
 # Roles Blender always provides (Combined RGBA) and roles it cannot render.
 BUILTIN_ROLES = {"colour", "alpha"}
 
@@ -22,15 +37,16 @@ def _owner(view_layer, owner):
 def wanted_toggles(needs):
     """(toggles to turn on, roles Blender cannot provide) for needs() = {"required", "optional"}."""
     roles = list(needs["required"]) + list(needs["optional"])
-    on = {ROLE_TOGGLES[r] for r in roles if r in ROLE_TOGGLES}
-    unavailable = [r for r in roles if r not in ROLE_TOGGLES and r not in BUILTIN_ROLES]
+    toggles = {**ROLE_TOGGLES, **LIGHT_TOGGLES}
+    on = {toggles[r] for r in roles if r in toggles}
+    unavailable = [r for r in roles if r not in toggles and r not in BUILTIN_ROLES]
     return on, unavailable
 
 
 def apply(scene, filter_name, needs, log=print):
     """Enables exactly the passes the filter's settings need or use (needs: the native module's
-    needs()) on every view layer of the scene and turns Cycles' own denoiser off. Returns the
-    messages it logged."""
+    needs()) on every view layer of the scene (light passes: on when needed, never turned off)
+    and turns Cycles' own denoiser off. Returns the messages it logged."""
     messages = []
     on, unavailable = wanted_toggles(needs)
     for vl in scene.view_layers:
@@ -38,6 +54,9 @@ def apply(scene, filter_name, needs, log=print):
             owner = _owner(vl, toggle[0])
             if owner is not None and hasattr(owner, toggle[1]):
                 setattr(owner, toggle[1], toggle in on)
+        for toggle in LIGHT_TOGGLES.values():
+            if toggle in on and hasattr(vl, toggle[1]):
+                setattr(vl, toggle[1], True)
     names = sorted(("cycles." if o else "") + a for o, a in on)
     messages.append(f"mcrecon: filter '{filter_name}' passes: combined"
                     + (", " + ", ".join(names) if names else " only"))

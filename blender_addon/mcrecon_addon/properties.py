@@ -65,6 +65,8 @@ def filter_params(settings, filter_name):
         elif v == d:
             continue
         out[spec["name"]] = v
+    if settings.light_passes:
+        out["components"] = "light_passes"
     for token in settings.extra_params.split():
         key, eq, value = token.partition("=")
         if not eq or not key:
@@ -131,6 +133,16 @@ def _base_annotations():
             description="Temporally accumulate the noisy colour across the frames of an animation before the "
                         "filter (as mcrecon denoise --accumulate; needs the Position and Normal passes, uses "
                         "Vector); history restarts on a frame jump"),
+        "light_passes": bpy.props.BoolProperty(
+            name="Denoise light passes", default=False, update=_on_filter_change,
+            description="Denoise Blender's diffuse, glossy and transmission light one by one, each by its own "
+                        "colour pass, and add them up (components=light_passes; turns the light passes on: "
+                        "Diffuse, Glossy, Transmission Direct/Indirect/Color, Emission, Environment)"),
+        "keep_components": bpy.props.BoolProperty(
+            name="Keep components", default=False,
+            description="With Denoise light passes: write each denoised component as its own layer of the output "
+                        "(<layer>.Denoised.Diffuse, Glossy, Transmission, Emission, Environment), summing to "
+                        "the beauty (mcrecon denoise --keep-components)"),
         "extra_params": bpy.props.StringProperty(
             name="Extra parameters", default="", update=_on_filter_change,
             description="Advanced: KEY=VALUE pairs passed to the filter as they are (like mcrecon denoise --set)"),

@@ -116,12 +116,13 @@ def denoise_render(scene, source, render_path):
         if _compositing(scene):
             passes = {"colour": "Composite.Combined"}
         try:
-            t = session.denoise_file(source, out, layer=layer, passes=passes)
+            t = session.denoise_file(source, out, layer=layer, passes=passes,
+                                     keep_components=scene.mcrecon.keep_components)
         except mc.Error as e:
             if not passes or e.kind != "missing_pass" or "Composite" not in str(e):
                 raise
             log(scene, "no Composite.Combined in the render: denoising the raw Combined")
-            t = session.denoise_file(source, out, layer=layer)
+            t = session.denoise_file(source, out, layer=layer, keep_components=scene.mcrecon.keep_components)
         _job["next"] = frame + 1
         log(scene, f"{session.filter}{' (accumulated)' if session.accumulate else ''} frame {frame}: {out} "
                    f"({t['filter_ms']:.0f} ms filter, {t['total_ms']:.0f} ms total)")

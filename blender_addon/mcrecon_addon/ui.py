@@ -20,6 +20,10 @@ class MCRECON_PT_render(bpy.types.Panel):
         layout.active = mc.enabled
         layout.prop(mc, "filter")
         layout.prop(mc, "accumulate")
+        layout.prop(mc, "light_passes")
+        row = layout.row()
+        row.active = mc.light_passes
+        row.prop(mc, "keep_components")
         info = native.get().filter_info(mc.filter)
         layout.label(text=info["summary"])
         group = getattr(mc, properties.group_attr(mc.filter))

@@ -338,10 +338,11 @@ class Session {
   }
 
   py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,
-                        const py::dict& passes, bool keep_passes) {
+                        const py::dict& passes, bool keep_passes, bool keep_components = false) {
     const mcr::ReadOptions ro = read_options(layer, passes);
     mcr::WriteOptions wo;
     wo.keep_passes = keep_passes;
+    wo.keep_components = keep_components;  // each denoised light component as a layer (components=light_passes)
     mcr::ReadOptions r = ro;
     r.keep_extra = keep_passes;
     const mcr::ExecOptions eo = exec_options(threads_, py::none());
@@ -443,10 +444,12 @@ PYBIND11_MODULE(mcrecon, m) {
           py::arg("normal_space") = "world", py::arg("roi") = py::none(),
           "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32.")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
-           py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
+           py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
            "Reads a render (multilayer EXR), filters it and writes output (temp + rename); returns stage timings "
            "and the notes (as notes()). "
-           "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}.");
+           "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}. keep_components=True "
+           "(with params components='light_passes'): each denoised light component as its own layer, as "
+           "--keep-components.");
 
   m.def(
       "denoise",
@@ -470,14 +473,15 @@ PYBIND11_MODULE(mcrecon, m) {
       "denoise_file",
       [](const std::string& input, const std::string& output, const std::string& filter, const py::dict& params,
          const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads,
-         const py::object& accumulate) {
+         const py::object& accumulate, bool keep_components) {
         Session s(filter, params, threads, accumulate);
-        return s.denoise_file(input, output, layer, passes, keep_passes);
+        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components);
       },
       py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
       py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
-      py::arg("threads") = 0, py::arg("accumulate") = false,
-      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate); returns "
+      py::arg("threads") = 0, py::arg("accumulate") = false, py::arg("keep_components") = false,
+      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate; "
+      "keep_components=True: --keep-components, with params={'components': 'light_passes'}); returns "
       "stage timings and the notes `--verbose` prints (filter='auto': the scores and the filter chosen).");
 
   m.def(
@@ -485,7 +489,8 @@ PYBIND11_MODULE(mcrecon, m) {
       [](const std::string& input, const std::string& output, const py::object& first_arg, const py::object& last_arg,
          const std::string& filter,
          const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
-         const std::optional<std::function<void(std::int64_t, std::int64_t, std::string)>>& progress, const py::object& accumulate) {
+         const std::optional<std::function<void(std::int64_t, std::int64_t, std::string)>>& progress, const py::object& accumulate,
+         bool keep_components) {
         const int first = int_from_py("first", first_arg), last = int_from_py("last", last_arg);
         for (const std::string* p : {&input, &output})
           if (!mcr::is_sequence_pattern(*p))
@@ -508,7 +513,7 @@ PYBIND11_MODULE(mcrecon, m) {
         py::list outputs;
         for (std::int64_t f = first; f <= last; ++f) {
           const std::string out = mcr::sequence_path(output, int(f));
-          s.denoise_file(inputs[std::size_t(f - first)], out, layer, passes, false);
+          s.denoise_file(inputs[std::size_t(f - first)], out, layer, passes, false, keep_components);
           outputs.append(out);
           if (progress) (*progress)(f - first + 1, std::int64_t(last) - first + 1, out);
         }
@@ -517,6 +522,7 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("input"), py::arg("output"), py::arg("first"), py::arg("last"), py::arg("filter"),
       py::arg("params") = py::dict(), py::arg("layer") = py::none(), py::arg("passes") = py::dict(),
       py::arg("threads") = 0, py::arg("progress") = py::none(), py::arg("accumulate") = false,
+      py::arg("keep_components") = false,
       "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history; "
       "accumulate=True as --accumulate); progress(done, total, output) is called after each frame. Returns the "
       "outputs written.");

@@ -20,6 +20,17 @@ const char* role_name(Role r) {
     case Role::SecondNormal: return "second_normal";
     case Role::SampleCount: return "sample_count";
     case Role::Alpha: return "alpha";
+    case Role::DiffuseDirect: return "diffuse_direct";
+    case Role::DiffuseIndirect: return "diffuse_indirect";
+    case Role::DiffuseColour: return "diffuse_colour";
+    case Role::GlossyDirect: return "glossy_direct";
+    case Role::GlossyIndirect: return "glossy_indirect";
+    case Role::GlossyColour: return "glossy_colour";
+    case Role::TransmissionDirect: return "transmission_direct";
+    case Role::TransmissionIndirect: return "transmission_indirect";
+    case Role::TransmissionColour: return "transmission_colour";
+    case Role::Emission: return "emission";
+    case Role::Environment: return "environment";
   }
   return "?";
 }
@@ -28,6 +39,9 @@ std::optional<Role> role_from_name(const std::string& name) {
   std::string n;
   for (char ch : name) n += char(std::tolower(static_cast<unsigned char>(ch)));
   if (n == "color") return Role::Colour;
+  const std::string us = "_color";  // diffuse_color, ...: the American spelling too
+  if (n.size() > us.size() && n.compare(n.size() - us.size(), us.size(), us) == 0)
+    n = n.substr(0, n.size() - us.size()) + "_colour";
   for (Role r : kAllRoles)
     if (n == role_name(r)) return r;
   return std::nullopt;
@@ -40,7 +54,18 @@ int role_channels(Role r) {
     case Role::Normal:
     case Role::Position:
     case Role::SecondPosition:
-    case Role::SecondNormal: return 3;
+    case Role::SecondNormal:
+    case Role::DiffuseDirect:
+    case Role::DiffuseIndirect:
+    case Role::DiffuseColour:
+    case Role::GlossyDirect:
+    case Role::GlossyIndirect:
+    case Role::GlossyColour:
+    case Role::TransmissionDirect:
+    case Role::TransmissionIndirect:
+    case Role::TransmissionColour:
+    case Role::Emission:
+    case Role::Environment: return 3;
     case Role::Motion: return 2;
     case Role::Depth:
     case Role::Variance:

@@ -22,15 +22,25 @@ enum class Role {
   SecondNormal,    // XYZ at the second hit
   SampleCount,     // 1 channel; 0 marks a hole in sparse renders
   Alpha,           // 1 channel
+  // Blender's light passes (components=light_passes, pipeline/components.h): the
+  // direct/indirect passes hold light already divided by their colour pass, RGB each.
+  DiffuseDirect, DiffuseIndirect, DiffuseColour,
+  GlossyDirect, GlossyIndirect, GlossyColour,
+  TransmissionDirect, TransmissionIndirect, TransmissionColour,
+  Emission, Environment,
 };
 
 inline constexpr Role kAllRoles[] = {Role::Colour,   Role::Albedo,         Role::Normal,
                                      Role::Position, Role::Depth,          Role::Motion,
                                      Role::Variance, Role::SecondPosition, Role::SecondNormal,
-                                     Role::SampleCount, Role::Alpha};
+                                     Role::SampleCount, Role::Alpha,
+                                     Role::DiffuseDirect, Role::DiffuseIndirect, Role::DiffuseColour,
+                                     Role::GlossyDirect, Role::GlossyIndirect, Role::GlossyColour,
+                                     Role::TransmissionDirect, Role::TransmissionIndirect, Role::TransmissionColour,
+                                     Role::Emission, Role::Environment};
 
 const char* role_name(Role r);                           // "colour", "albedo", ...
-std::optional<Role> role_from_name(const std::string&);  // accepts "color" too
+std::optional<Role> role_from_name(const std::string&);  // accepts "color", "diffuse_color" too
 int role_channels(Role r);                               // channels a filter may rely on
 
 // Coordinate space of a geometric pass; filters that compare geometry across

@@ -50,7 +50,35 @@ const Alias kAliases[] = {
     {"sample count", Role::SampleCount, Space::None, 2}, {"debug sample count", Role::SampleCount, Space::None, 1},
     {"samples", Role::SampleCount, Space::None, 1},    {"spp", Role::SampleCount, Space::None, 1},
     {"alpha", Role::Alpha, Space::None, 2},
+    // Light passes: Blender's names, then the role names (plain files, loose files).
+    {"diffdir", Role::DiffuseDirect, Space::None, 2},  {"diffind", Role::DiffuseIndirect, Space::None, 2},
+    {"diffcol", Role::DiffuseColour, Space::None, 2},  {"glossdir", Role::GlossyDirect, Space::None, 2},
+    {"glossind", Role::GlossyIndirect, Space::None, 2}, {"glosscol", Role::GlossyColour, Space::None, 2},
+    {"transdir", Role::TransmissionDirect, Space::None, 2}, {"transind", Role::TransmissionIndirect, Space::None, 2},
+    {"transcol", Role::TransmissionColour, Space::None, 2}, {"emit", Role::Emission, Space::None, 2},
+    {"env", Role::Environment, Space::None, 2},
+    {"diffuse_direct", Role::DiffuseDirect, Space::None, 1}, {"diffuse_indirect", Role::DiffuseIndirect, Space::None, 1},
+    {"diffuse_colour", Role::DiffuseColour, Space::None, 1}, {"diffuse_color", Role::DiffuseColour, Space::None, 1},
+    {"glossy_direct", Role::GlossyDirect, Space::None, 1}, {"glossy_indirect", Role::GlossyIndirect, Space::None, 1},
+    {"glossy_colour", Role::GlossyColour, Space::None, 1}, {"glossy_color", Role::GlossyColour, Space::None, 1},
+    {"transmission_direct", Role::TransmissionDirect, Space::None, 1},
+    {"transmission_indirect", Role::TransmissionIndirect, Space::None, 1},
+    {"transmission_colour", Role::TransmissionColour, Space::None, 1},
+    {"transmission_color", Role::TransmissionColour, Space::None, 1},
+    {"emission", Role::Emission, Space::None, 1},      {"environment", Role::Environment, Space::None, 1},
 };
+
+// Roles whose channels are read R,G,B first.
+bool rgb_role(Role r) {
+  switch (r) {
+    case Role::Normal:
+    case Role::Position:
+    case Role::SecondPosition:
+    case Role::SecondNormal:
+    case Role::Albedo: return false;
+    default: return true;
+  }
+}
 
 // Channel suffix orders a role accepts, best first.
 const std::vector<std::vector<std::string>>& orders(Role role) {
@@ -59,7 +87,7 @@ const std::vector<std::vector<std::string>>& orders(Role role) {
   static const std::vector<std::vector<std::string>> vec2 = {{"x", "y"}, {"r", "g"}, {"u", "v"}};
   static const std::vector<std::vector<std::string>> scalar = {{"z"}, {"v"}, {"y"}, {"r"}, {"x"}, {"a"}};
   switch (role_channels(role)) {
-    case 3: return role == Role::Colour ? colour : vec3;
+    case 3: return rgb_role(role) ? colour : vec3;
     case 2: return vec2;
     default: return scalar;
   }
@@ -155,6 +183,7 @@ std::vector<RoleMatch> classify_group(const ChannelGroup& group) {
     }
     return out;
   }
+  // Every alias of the name: DiffCol is the diffuse colour pass and the albedo of last resort.
   for (const Alias& a : kAliases) {
     if (pass != a.name) continue;
     if (auto idx = pick(group, a.role)) {
@@ -166,7 +195,6 @@ std::vector<RoleMatch> classify_group(const ChannelGroup& group) {
         if (!alpha.indices.empty()) out.push_back({Role::Alpha, Space::None, a.priority, alpha.indices});
       }
     }
-    break;
   }
   return out;
 }

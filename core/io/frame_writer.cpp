@@ -28,8 +28,17 @@ void write_result(const std::string& path, const Image& rgb, const Frame& input,
   std::vector<Source> src = {{&rgb, 0}, {&rgb, 1}, {&rgb, 2}, {nullptr, 0}};
   if (const Pass* a = input.find(Role::Alpha)) src[3] = {&a->image, 0};
 
+  std::set<std::string> taken(names.begin(), names.end());
+  for (const auto& [name, image] : options.layers) {
+    if (!image || image->width() != input.width || image->height() != input.height || image->channels() < 3)
+      throw Error(Errc::Internal, "write_result: layer '" + name + "' does not match the frame");
+    for (int c = 0; c < 3; ++c) {
+      names.push_back(name + "." + "RGB"[c]);
+      taken.insert(names.back());
+      src.push_back({image, c});
+    }
+  }
   if (options.keep_passes) {
-    std::set<std::string> taken(names.begin(), names.end());
     auto add = [&](const Pass& p) {
       for (int c = 0; c < p.image.channels(); ++c) {
         // Loose-file passes get "<role>.X" names; the input's keep their own.

@@ -195,6 +195,7 @@ const FilterInfo& AutoFilter::static_info() {
         ParamSpec::Float("min_gain", 0.05, 0.0, 1.0,
                          "a candidate must be estimated to cut the input's relMSE by this share, else the input is "
                          "kept as it is"),
+        components_param(),
     };
     i.required = {Role::Colour};
     i.optional = {Role::Normal,   Role::Position,       Role::Albedo,       Role::Depth,       Role::Variance,

@@ -27,6 +27,7 @@ DenoiseSession::DenoiseSession(const std::string& filter,
 
 StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
                                const WriteOptions& write, const ExecOptions& exec) {
+  if (write.keep_components) check_keep_components(reconstruction_.filter().params());
   if (!output.empty()) {
     // Every front end's file run passes here: the output is checked against every
     // input of the run (the render and any loose pass file) before anything is read.
@@ -44,7 +45,8 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
   t0 = std::chrono::steady_clock::now();
   // The frame is ours: with accumulation its colour becomes the accumulated one, which
   // the writer never reads (it takes alpha and the other channels from it).
-  const Image result = reconstruction_.run_in_place(frame, exec);
+  std::vector<ComponentImage> components;
+  const Image result = reconstruction_.run_in_place(frame, exec, write.keep_components ? &components : nullptr);
   t.filter_ms = ms_since(t0);
 
   if (!output.empty()) {
@@ -52,6 +54,8 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     WriteOptions w = write;
     w.attributes.emplace_back("mcreconFilter", reconstruction_.filter().info().name);
     w.attributes.emplace_back("mcreconParameters", reconstruction_.parameters_text());
+    for (const ComponentImage& c : components)
+      w.layers.emplace_back(component_layer_prefix(frame.layer) + c.name, &c.rgb);
     write_result(output, result, frame, w);
     t.write_ms = ms_since(t0);
   }

@@ -32,7 +32,8 @@ class DenoiseSession {
   // Reads input, filters, and writes output unless output is empty (warm-up of
   // temporal history on frames that already have an output). The output is checked
   // first (io/output_guard.h): never an input of the run, only a regular file or a
-  // new path.
+  // new path. write.keep_components (needs components=light_passes) adds every denoised
+  // component as its own layer (pipeline/components.h), summing to R,G,B exactly.
   StageTimes run(const std::string& input, const std::string& output, const ReadOptions& read,
                  const WriteOptions& write, const ExecOptions& exec);
 

@@ -20,63 +20,133 @@ std::string parameters_text(const Filter& filter) {
   return params;
 }
 
-Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate)
-    : filter_(std::move(filter)), accumulate_(accumulate) {
-  if (!filter_) throw Error(Errc::Internal, "Reconstruction without a filter");
+namespace {
+
+// A filter like `f`: the same kind, every setting given to f given to it, committed.
+std::unique_ptr<Filter> same_filter(const Filter& f) {
+  std::unique_ptr<Filter> g = make_catalog_filter(f.info().name);
+  for (const auto& kv : f.params().values())
+    if (f.params().was_set(kv.first)) g->set(kv.first, kv.second);
+  return g;
+}
+
+}  // namespace
+
+Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate) : accumulate_(accumulate) {
+  if (!filter) throw Error(Errc::Internal, "Reconstruction without a filter");
+  const bool split = uses_light_passes(filter->params());
+  if (split) {
+    // The light passes are already divided by their colour pass: a second division by the
+    // albedo would remodulate the light with the wrong colour.
+    for (const char* name : {"demodulate", "albedo_demodulation"}) {
+      if (!filter->params().has(name)) continue;
+      if (filter->params().was_set(name) && filter->params().get_bool(name))
+        setup_notes_.push_back(std::string(name) + "=true has no effect with components=light_passes (each light pass "
+                                                   "is already divided by its colour pass)");
+      filter->set(name, false);
+    }
+    filter->commit();
+  }
+  const std::size_t count = split ? light_components().size() : 1;
+  for (std::size_t i = 0; i < count; ++i) {
+    auto stage = std::make_unique<Stage>();
+    if (i == 0) {
+      stage->filter = std::move(filter);
+    } else {
+      stage->filter = same_filter(*stages_.front()->filter);
+      stage->filter->commit();
+    }
+    stages_.push_back(std::move(stage));
+  }
 }
 
 PassNeeds Reconstruction::needs() const {
-  PassNeeds n = filter_->needs();
+  PassNeeds n = filter().needs();
   if (accumulate_) {
     n.require(Role::Position, "accumulate");
     n.require(Role::Normal, "accumulate");
     n.use(Role::Motion);
   }
+  if (light_passes())
+    for (Role r : light_pass_roles()) n.require(r, "components=light_passes");
   return n;
 }
 
-Image Reconstruction::run(const Frame& frame, const ExecOptions& options) {
-  if (!accumulate_) {
+Image Reconstruction::run(const Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components) {
+  if (!accumulate_ || light_passes()) {
     const std::lock_guard<std::mutex> lock(mutex_);
     notes_.clear();
-    return filter_->execute(frame, options);
+    if (light_passes()) return run_components(frame, options, components);
+    return filter().execute(frame, options);
   }
   Frame copy = frame;  // the accumulated colour replaces the copy's, not the caller's
-  return run_in_place(copy, options);
+  return run_in_place(copy, options, components);
 }
 
-Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options) {
+Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components) {
   const std::lock_guard<std::mutex> lock(mutex_);
   notes_.clear();
-  if (!accumulate_) return filter_->execute(frame, options);
-  // Accumulation's passes first: nothing is accumulated for a frame the filter refuses.
-  check_passes(needs(), frame, "filter '" + filter_->info().name + "' with accumulation");
+  if (light_passes()) return run_components(frame, options, components);
+  if (accumulate_)  // accumulation's passes first: nothing is accumulated for a frame the filter refuses
+    check_passes(needs(), frame, "filter '" + filter().info().name + "' with accumulation");
+  return run_stage(*stages_.front(), frame, options);
+}
+
+Image Reconstruction::run_stage(Stage& stage, Frame& frame, const ExecOptions& options) {
+  if (!accumulate_) return stage.filter->execute(frame, options);
   Image& colour = frame.passes[std::size_t(&frame.get(Role::Colour) - frame.passes.data())].image;
-  const Image& acc =
-      accumulator_.accumulate(frame, colour.channels() == 3 ? colour : colour.channel_range(0, 3), options.nthreads);
+  const Image& acc = stage.accumulator.accumulate(frame, colour.channels() == 3 ? colour : colour.channel_range(0, 3),
+                                                  options.nthreads);
   const std::size_t ch = std::size_t(colour.channels());
   for (std::size_t i = 0; i < acc.pixel_count(); ++i)
     for (std::size_t c = 0; c < 3; ++c) colour.data()[i * ch + c] = acc.data()[i * 3 + c];
-  if (accumulator_.last_reprojection().cut) notes_.push_back("accumulation: camera cut, history restarted");
-  return filter_->execute(frame, options);
+  if (stage.accumulator.last_reprojection().cut) notes_.push_back("accumulation: camera cut, history restarted");
+  return stage.filter->execute(frame, options);
+}
+
+Image Reconstruction::run_components(const Frame& frame, const ExecOptions& options,
+                                     std::vector<ComponentImage>* components) {
+  // Every pass first (the light passes, then the filter's and accumulation's on the beauty
+  // frame): no component's history moves for a frame another component would refuse.
+  check_light_passes(frame);
+  check_passes(needs(), frame,
+               "filter '" + filter().info().name + "'" + (accumulate_ ? " with accumulation" : "") +
+                   " with components=light_passes");
+  const auto& comps = light_components();
+  std::vector<Image> filtered;
+  for (std::size_t i = 0; i < comps.size(); ++i) {
+    Frame part = component_frame(frame, comps[i], options.nthreads);
+    const std::size_t before = notes_.size();
+    filtered.push_back(run_stage(*stages_[i], part, options));
+    for (std::size_t k = before; k < notes_.size(); ++k) notes_[k] = std::string(comps[i].name) + ": " + notes_[k];
+    for (const std::string& m : stages_[i]->filter->notes()) notes_.push_back(std::string(comps[i].name) + ": " + m);
+  }
+  Recombined r = recombine(frame, filtered, options.nthreads);
+  notes_.push_back("components=light_passes: diffuse, glossy and transmission light (direct + indirect) filtered one "
+                   "by one and multiplied by their colour pass; emission and environment passed through");
+  if (components) *components = std::move(r.layers);
+  return std::move(r.beauty);
 }
 
 void Reconstruction::reset() {
   const std::lock_guard<std::mutex> lock(mutex_);
-  accumulator_.reset();
-  filter_->reset();
+  for (auto& stage : stages_) {
+    stage->accumulator.reset();
+    stage->filter->reset();
+  }
 }
 
 std::vector<std::string> Reconstruction::notes() const {
   const std::lock_guard<std::mutex> lock(mutex_);
-  std::vector<std::string> all = filter_->unused_settings();
-  all.insert(all.end(), filter_->notes().begin(), filter_->notes().end());
+  std::vector<std::string> all = filter().unused_settings();
+  all.insert(all.end(), setup_notes_.begin(), setup_notes_.end());
+  if (!light_passes()) all.insert(all.end(), filter().notes().begin(), filter().notes().end());
   all.insert(all.end(), notes_.begin(), notes_.end());
   return all;
 }
 
 std::string Reconstruction::parameters_text() const {
-  const std::string own = mcr::parameters_text(*filter_);
+  const std::string own = mcr::parameters_text(filter());
   return accumulate_ ? "accumulate=true " + own : own;
 }
 

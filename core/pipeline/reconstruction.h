@@ -6,6 +6,11 @@
 // colour pass holds the accumulated RGB (alpha and other channels kept). Only the
 // pipeline combines stages; the filter knows nothing of it.
 //
+// With components=light_passes (pipeline/components.h) each light component runs through
+// its own accumulation and filter (one history per component); the filter's demodulation
+// is turned off (the light passes are already demodulated) and the result is their
+// recombination.
+//
 // Shared use: run(), run_in_place(), reset() and notes() may be called from several
 // threads at once; they are serialised (a mutex held for the whole call), in the order
 // the calls take the lock. A temporal session's frame order is then the caller's
@@ -17,6 +22,7 @@
 #include <vector>
 
 #include "filters/filter.h"
+#include "pipeline/components.h"
 #include "temporal/accumulation.h"
 
 namespace mcr {
@@ -25,21 +31,25 @@ class Reconstruction {
  public:
   Reconstruction(std::unique_ptr<Filter> filter, bool accumulate);
 
-  Filter& filter() { return *filter_; }
-  const Filter& filter() const { return *filter_; }
+  Filter& filter() { return *stages_.front()->filter; }
+  const Filter& filter() const { return *stages_.front()->filter; }
+  // components=light_passes: one stage per light component.
+  bool light_passes() const { return stages_.size() > 1; }
   bool accumulates() const { return accumulate_; }
   // Frame order matters (history between run() calls): a temporal filter, or accumulation.
-  bool temporal() const { return accumulate_ || filter_->info().temporal; }
+  bool temporal() const { return accumulate_ || filter().info().temporal; }
 
-  // The filter's needs plus the accumulation's (world position and normal; motion used).
+  // The filter's needs plus the accumulation's (world position and normal; motion used),
+  // plus every light pass with components=light_passes.
   PassNeeds needs() const;
 
   // Checks the passes (MissingPass naming the frame's file, before any work), accumulates
-  // when asked, runs the filter.
-  Image run(const Frame& frame, const ExecOptions& options = {});
+  // when asked, runs the filter. With light passes, `components` (when given) receives the
+  // recombined layers, which sum to the returned beauty exactly.
+  Image run(const Frame& frame, const ExecOptions& options = {}, std::vector<ComponentImage>* components = nullptr);
   // The same without copying the frame: with accumulation its colour pass's RGB becomes
   // the accumulated one (alpha and other channels kept).
-  Image run_in_place(Frame& frame, const ExecOptions& options = {});
+  Image run_in_place(Frame& frame, const ExecOptions& options = {}, std::vector<ComponentImage>* components = nullptr);
   // Drops the history of both stages (new shot, frames out of order).
   void reset();
 
@@ -50,9 +60,18 @@ class Reconstruction {
   std::string parameters_text() const;
 
  private:
-  std::unique_ptr<Filter> filter_;
+  // One filter and its accumulation history: the beauty's, or one light component's.
+  struct Stage {
+    std::unique_ptr<Filter> filter;
+    TemporalAccumulator accumulator;
+  };
+  // Accumulates frame's colour in place when asked, runs the stage's filter.
+  Image run_stage(Stage& stage, Frame& frame, const ExecOptions& options);
+  Image run_components(const Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components);
+
+  std::vector<std::unique_ptr<Stage>> stages_;
   bool accumulate_ = false;
-  TemporalAccumulator accumulator_;
+  std::vector<std::string> setup_notes_;  // settings the components mode overrides
   std::vector<std::string> notes_;
   // Held across every call that reads or changes the filter's per-run state (its prepared
   // buffers and notes) or the accumulation history: one frame at a time.

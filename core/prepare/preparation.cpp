@@ -50,7 +50,15 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
     own.push_back(ParamSpec::Int("step_back_radius", 4, 1, 16,
                                  "half width of the window over which step_back weighs the result against the input"));
   }
+  own.push_back(components_param());
   return own;
+}
+
+ParamSpec components_param() {
+  return ParamSpec::Enum("components", "beauty", {"beauty", "light_passes"},
+                         "beauty = filter the Combined pass; light_passes = filter Blender's diffuse, glossy and "
+                         "transmission light (direct + indirect, already divided by their colour pass) one by one, "
+                         "multiply each by its colour pass, add emission and environment as they are");
 }
 
 namespace {

@@ -31,8 +31,12 @@ struct PrepSteps {
   static PrepSteps none() { return {false, false, false, false, false}; }
 };
 
-// `own` followed by the parameters of the steps.
+// `own` followed by the parameters of the steps, then `components`.
 ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps);
+
+// `components` (beauty | light_passes), in every filter's table so that every front end
+// takes it by the same name; the pipeline reads it (pipeline/components.h), no filter does.
+ParamSpec components_param();
 
 // The passes the steps need under these settings (demodulate: albedo; holes=sample_count
 // / alpha: that pass) and those they use when present (albedo_prefilter: albedo, normal,

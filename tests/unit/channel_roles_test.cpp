@@ -172,7 +172,7 @@ TEST(ChannelRolesTest, ShortAndLowerCaseNames) {
 }
 
 TEST(ChannelRolesTest, UnknownOrIncompleteGroupsGiveNoRole) {
-  EXPECT_TRUE(roles_of({"L.Emit.R", "L.Emit.G", "L.Emit.B"}, "L.Emit").empty());
+  EXPECT_TRUE(roles_of({"L.AO.R", "L.AO.G", "L.AO.B"}, "L.AO").empty());
   EXPECT_TRUE(roles_of({"L.Normal.X", "L.Normal.Y"}, "L.Normal").empty());  // Z missing
   EXPECT_TRUE(roles_of({"L.CryptoObject00.R", "L.CryptoObject00.G"}, "L.CryptoObject00").empty());
 }

@@ -155,7 +155,8 @@ TEST(FilterContract, AFilterWithoutStepsSeesTheRenderAsItIs) {
   NoStepsFilter f;
   for (const char* p : {"demodulate", "albedo_floor", "albedo_prefilter", "holes", "firefly_k", "firefly_radius", "clamp"})
     EXPECT_FALSE(f.params().has(p)) << p;
-  EXPECT_EQ(f.params().values().size(), 1u);
+  EXPECT_EQ(f.params().values().size(), 2u);  // its own, and components (read by the pipeline only)
+  EXPECT_TRUE(f.params().has("components"));
   f.set("gain", 2.0);
   f.commit();
   const Frame frame = busy_frame(20, 15, 14);  // holes and spikes the steps would change

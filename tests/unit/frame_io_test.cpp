@@ -302,7 +302,7 @@ TEST_F(FrameIoTest, TruncatedFilesAreReadErrorsNotCrashes) {
 }
 
 TEST_F(FrameIoTest, KeepExtraCollectsChannelsWithoutRole) {
-  const Names ch = concat({blender_layer("ViewLayer"), {"ViewLayer.Emit.R", "ViewLayer.Emit.G", "ViewLayer.Emit.B",
+  const Names ch = concat({blender_layer("ViewLayer"), {"ViewLayer.AO.R", "ViewLayer.AO.G", "ViewLayer.AO.B",
                                                         "ViewLayer.CryptoObject00.R"}});
   write_exr(path("ml.exr"), 3, 2, ch);
   ReadOptions ro;
@@ -311,7 +311,7 @@ TEST_F(FrameIoTest, KeepExtraCollectsChannelsWithoutRole) {
   Names extra;
   for (const Pass& p : f.extra) extra.push_back(p.name);
   std::sort(extra.begin(), extra.end());
-  EXPECT_EQ(extra, (Names{"ViewLayer.CryptoObject00", "ViewLayer.Emit"}));
+  EXPECT_EQ(extra, (Names{"ViewLayer.AO", "ViewLayer.CryptoObject00"}));
   EXPECT_TRUE(read_frame(path("ml.exr")).extra.empty());
 
   // Candidates an override replaced are input channels like any other: extra, not dropped.
@@ -320,7 +320,7 @@ TEST_F(FrameIoTest, KeepExtraCollectsChannelsWithoutRole) {
   extra.clear();
   for (const Pass& p : o.extra) extra.push_back(p.name);
   std::sort(extra.begin(), extra.end());
-  EXPECT_EQ(extra, (Names{"ViewLayer.CryptoObject00", "ViewLayer.Denoising Normal", "ViewLayer.Emit"}));
+  EXPECT_EQ(extra, (Names{"ViewLayer.AO", "ViewLayer.CryptoObject00", "ViewLayer.Denoising Normal"}));
 }
 
 // ---------------------------------------------------------------- writing

@@ -1,0 +1,181 @@
+#include "pipeline/components.h"
+
+#include <cfloat>
+#include <cmath>
+
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+namespace {
+
+// Blender's pass name of each light role, for messages.
+const char* blender_name(Role r) {
+  switch (r) {
+    case Role::DiffuseDirect: return "DiffDir";
+    case Role::DiffuseIndirect: return "DiffInd";
+    case Role::DiffuseColour: return "DiffCol";
+    case Role::GlossyDirect: return "GlossDir";
+    case Role::GlossyIndirect: return "GlossInd";
+    case Role::GlossyColour: return "GlossCol";
+    case Role::TransmissionDirect: return "TransDir";
+    case Role::TransmissionIndirect: return "TransInd";
+    case Role::TransmissionColour: return "TransCol";
+    case Role::Emission: return "Emit";
+    case Role::Environment: return "Env";
+    default: return role_name(r);
+  }
+}
+
+// Non-finite as 0, +-inf as +-FLT_MAX.
+float finite_or_zero(float v) {
+  if (std::isnan(v)) return 0.0f;
+  if (std::isinf(v)) return v > 0 ? FLT_MAX : -FLT_MAX;
+  return v;
+}
+
+float clamped(float v) {
+  if (std::isnan(v)) return 0.0f;
+  return v > FLT_MAX ? FLT_MAX : v < -FLT_MAX ? -FLT_MAX : v;
+}
+
+}  // namespace
+
+const std::vector<LightComponent>& light_components() {
+  static const std::vector<LightComponent> list = {
+      {"diffuse", "Diffuse", Role::DiffuseDirect, Role::DiffuseIndirect, Role::DiffuseColour},
+      {"glossy", "Glossy", Role::GlossyDirect, Role::GlossyIndirect, Role::GlossyColour},
+      {"transmission", "Transmission", Role::TransmissionDirect, Role::TransmissionIndirect, Role::TransmissionColour},
+  };
+  return list;
+}
+
+const std::vector<std::string>& component_layer_names() {
+  static const std::vector<std::string> names = {"Diffuse", "Glossy", "Transmission", "Emission", "Environment"};
+  return names;
+}
+
+bool uses_light_passes(const ParamSet& params) {
+  return params.has("components") && params.get_enum("components") == "light_passes";
+}
+
+void check_keep_components(const ParamSet& params) {
+  if (uses_light_passes(params)) return;
+  throw Error(Errc::InvalidArgument,
+              "keep_components (--keep-components) writes the denoised light components and needs "
+              "components=light_passes (the filter runs with components=" +
+                  (params.has("components") ? params.get_enum("components") : std::string("beauty")) + ")");
+}
+
+std::string component_layer_prefix(const std::string& layer) {
+  return layer.empty() ? "Denoised." : layer + ".Denoised.";
+}
+
+std::vector<Role> light_pass_roles() {
+  std::vector<Role> roles;
+  for (const LightComponent& c : light_components())
+    for (Role r : {c.direct, c.indirect, c.colour}) roles.push_back(r);
+  roles.push_back(Role::Emission);
+  roles.push_back(Role::Environment);
+  return roles;
+}
+
+void check_light_passes(const Frame& frame) {
+  std::string missing;
+  int count = 0;
+  for (Role r : light_pass_roles())
+    if (!frame.has(r)) {
+      missing += (missing.empty() ? "" : ", ") + std::string(blender_name(r)) + " (" + role_name(r) + ")";
+      ++count;
+    }
+  if (missing.empty()) return;
+  throw Error(Errc::MissingPass,
+              "components=light_passes needs Blender's light passes; " + std::string(count > 1 ? "these are" : "this is") +
+                  " absent in '" + frame.path + "'" + (frame.layer.empty() ? "" : " (layer '" + frame.layer + "')") +
+                  ": " + missing +
+                  " (enable Diffuse, Glossy and Transmission Direct, Indirect and Color, Emission and Environment on the "
+                  "view layer, or use components=beauty)");
+}
+
+Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads) {
+  Frame out;
+  out.width = frame.width;
+  out.height = frame.height;
+  out.path = frame.path;
+  out.layer = frame.layer;
+  out.layers = frame.layers;
+  out.frame_number = frame.frame_number;
+  out.window = frame.window;
+  out.deep = frame.deep;
+  const Pass& direct = frame.get(component.direct);
+  const Pass& indirect = frame.get(component.indirect);
+  for (const Pass& p : frame.passes) {
+    switch (p.role) {
+      case Role::Normal:
+      case Role::Position:
+      case Role::Depth:
+      case Role::Albedo:
+      case Role::Motion:
+      case Role::SecondPosition:
+      case Role::SecondNormal:
+      case Role::SampleCount:
+      case Role::Alpha: out.passes.push_back(p); break;
+      default: break;  // colour, variance (the beauty's), the light passes
+    }
+  }
+  Pass light;
+  light.role = Role::Colour;
+  light.name = direct.name + "+" + indirect.name;
+  light.source = direct.source;
+  light.priority = 3;
+  light.image = Image(frame.width, frame.height, 3);
+  const Image& a = direct.image;
+  const Image& b = indirect.image;
+  const int ca = a.channels(), cb = b.channels();
+  parallel_rows(0, frame.height, nthreads, [&](int y) {
+    for (int x = 0; x < frame.width; ++x) {
+      const float* pa = a.pixel(x, y);
+      const float* pb = b.pixel(x, y);
+      float* o = light.image.pixel(x, y);
+      for (int c = 0; c < 3; ++c) o[c] = pa[c < ca ? c : 0] + pb[c < cb ? c : 0];
+    }
+  });
+  out.passes.push_back(std::move(light));
+  return out;
+}
+
+Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int nthreads) {
+  const auto& comps = light_components();
+  if (filtered.size() != comps.size())
+    throw Error(Errc::Internal, "recombine: " + std::to_string(filtered.size()) + " filtered components");
+  const int w = frame.width, h = frame.height;
+  Recombined r;
+  for (const std::string& name : component_layer_names()) r.layers.push_back({name, Image(w, h, 3)});
+  r.beauty = Image(w, h, 3);
+  std::vector<const Image*> colour;
+  for (const LightComponent& c : comps) colour.push_back(&frame.image(c.colour));
+  const Image& emit = frame.image(Role::Emission);
+  const Image& env = frame.image(Role::Environment);
+  parallel_rows(0, h, nthreads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      float* sum = r.beauty.pixel(x, y);
+      for (int c = 0; c < 3; ++c) sum[c] = 0.0f;
+      auto add = [&](std::size_t layer, float v, int c) {
+        r.layers[layer].rgb.at(x, y, c) = v;
+        sum[c] = clamped(sum[c] + v);
+      };
+      for (std::size_t k = 0; k < comps.size(); ++k) {
+        const float* light = filtered[k].pixel(x, y);
+        const float* col = colour[k]->pixel(x, y);
+        const int cc = colour[k]->channels();
+        for (int c = 0; c < 3; ++c) add(k, clamped(light[c] * finite_or_zero(col[c < cc ? c : 0])), c);
+      }
+      for (int c = 0; c < 3; ++c) add(comps.size(), finite_or_zero(emit.at(x, y, c < emit.channels() ? c : 0)), c);
+      for (int c = 0; c < 3; ++c) add(comps.size() + 1, finite_or_zero(env.at(x, y, c < env.channels() ? c : 0)), c);
+    }
+  });
+  return r;
+}
+
+}  // namespace mcr

@@ -1,0 +1,110 @@
+"""`mcrecon denoise --set components=light_passes --keep-components` on a synthetic multilayer EXR
+with every Blender light pass (light_passes_testutil.py).
+
+Oracles: each component run alone through the CLI as an ordinary beauty (a file whose Combined is
+that component's direct + indirect light, with the same features), multiplied by its colour pass in
+numpy, plus Emit and Env, is the light_passes output; the written component layers add up to the
+written beauty within 1e-5 relative per pixel; a missing light pass is refused naming it and the
+file; --keep-components without light passes is refused.
+
+Run by ctest as `/usr/bin/python3 tests/python/test_cli_components.py` with MCRECON_BIN.
+"""
+import os
+import shutil
+import sys
+import tempfile
+import unittest
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import light_passes_testutil as lp  # noqa: E402
+import mcrecon_testutil as tu  # noqa: E402
+
+RGB = ["R", "G", "B"]
+
+
+class ComponentsCliTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="mcrecon_components_")
+        self.addCleanup(shutil.rmtree, self.tmp, ignore_errors=True)
+        self.passes = lp.make_passes()
+        self.input = os.path.join(self.tmp, "render.exr")
+        lp.write_multilayer(self.input, self.passes)
+
+    def path(self, name):
+        return os.path.join(self.tmp, name)
+
+    def denoise(self, *args, check=True):
+        return tu.run_cli("denoise", *args, check=check)
+
+    def test_components_equal_each_light_filtered_alone_and_sum_to_the_beauty(self):
+        for filt in ("box", "bilateral"):
+            with self.subTest(filter=filt):
+                out = self.path("out_%s.exr" % filt)
+                proc = self.denoise("-f", filt, "--set", "components=light_passes", "--keep-components",
+                                    self.input, "-o", out, "-v")
+                self.assertIn("components=light_passes", proc.stderr)
+                beauty = tu.read_channels(out, RGB)
+                layers = {n: tu.read_channels(out, lp.component_layer_channels(n)) for n in lp.LAYERS}
+                # The written layers add up to the written beauty.
+                total = np.zeros_like(beauty)
+                for n in lp.LAYERS:
+                    total += layers[n]
+                np.testing.assert_array_less(np.abs(total - beauty), 1e-5 * np.abs(beauty) + 1e-30)
+                # Each component as the CLI filters an ordinary beauty, times its colour pass.
+                expected = self.passes["Emit"] + self.passes["Env"]
+                for name, short in lp.COMPONENTS:
+                    light = self.passes[short + "Dir"] + self.passes[short + "Ind"]
+                    single = self.path("%s_%s.exr" % (filt, short))
+                    lp.write_single(single, light, self.passes)
+                    self.denoise("-f", filt, single, "-o", single + ".out.exr")
+                    want = tu.read_channels(single + ".out.exr", RGB) * self.passes[short + "Col"]
+                    np.testing.assert_allclose(layers[name], want, rtol=1e-6, atol=1e-7, err_msg=name)
+                    expected = expected + want
+                np.testing.assert_array_equal(layers["Emission"], self.passes["Emit"])
+                np.testing.assert_array_equal(layers["Environment"], self.passes["Env"])
+                np.testing.assert_allclose(beauty, expected, rtol=1e-5, atol=1e-6)
+                # And it is not the beauty filtered as a whole.
+                whole = self.path("whole_%s.exr" % filt)
+                self.denoise("-f", filt, self.input, "-o", whole)
+                self.assertGreater(np.abs(tu.read_channels(whole, RGB) - beauty).max(), 1e-3)
+
+    def test_a_missing_light_pass_is_named_with_the_file(self):
+        broken = self.path("no_gloss.exr")
+        lp.write_multilayer(broken, self.passes, leave_out=("GlossInd", "Env"))
+        proc = self.denoise("-f", "box", "--set", "components=light_passes", broken, "-o", self.path("o.exr"),
+                            check=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        for text in ("GlossInd", "Env", "no_gloss.exr", "components=light_passes"):
+            self.assertIn(text, proc.stderr)
+        self.assertNotIn("DiffDir", proc.stderr)
+        self.assertFalse(os.path.exists(self.path("o.exr")))
+
+    def test_keep_components_needs_light_passes_and_bad_values_are_refused(self):
+        proc = self.denoise("-f", "box", "--keep-components", self.input, "-o", self.path("o.exr"), check=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        self.assertIn("components=light_passes", proc.stderr)
+        proc = self.denoise("-f", "atrous", "--set", "components=lights", self.input, "-o", self.path("o.exr"),
+                            check=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        for text in ("lights", "beauty", "light_passes"):
+            self.assertIn(text, proc.stderr)
+        self.assertFalse(os.path.exists(self.path("o.exr")))
+
+    def test_every_filter_takes_components(self):
+        listing = tu.run_cli_json("filters", "--json")
+        filters = listing["filters"]
+        names = [f["name"] for f in filters]
+        self.assertIn("auto", names)
+        for f in filters:
+            self.assertIn("components", [p["name"] for p in f["parameters"]], f["name"])
+        out = self.path("auto.exr")
+        proc = self.denoise("-f", "auto", "--set", "components=light_passes", "--keep-components", self.input,
+                            "-o", out, "-v")
+        self.assertIn("diffuse: auto:", proc.stderr)
+        self.assertIn("transmission: auto:", proc.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()

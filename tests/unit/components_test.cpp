@@ -1,0 +1,216 @@
+// components=light_passes (pipeline/components.h, pipeline/reconstruction.h): each light
+// component filtered alone, times its colour pass, plus emission and environment. Oracles:
+// the box mean written out plainly per component; the components' own filters run alone on
+// frames the test builds; the sum of the layers recomputed here.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "expect_error.h"
+#include "feature_filter_testutil.h"
+#include "io/channel_roles.h"
+#include "pipeline/components.h"
+#include "pipeline/reconstruction.h"
+
+namespace mcr {
+namespace {
+
+using testutil::add_pass;
+using testutil::box_oracle;
+using testutil::random_image;
+
+struct Parts {
+  Role direct, indirect, colour;
+};
+const Parts kParts[3] = {{Role::DiffuseDirect, Role::DiffuseIndirect, Role::DiffuseColour},
+                         {Role::GlossyDirect, Role::GlossyIndirect, Role::GlossyColour},
+                         {Role::TransmissionDirect, Role::TransmissionIndirect, Role::TransmissionColour}};
+
+Image sum_of(const Image& a, const Image& b) {
+  Image s(a.width(), a.height(), 3);
+  for (std::size_t i = 0; i < s.storage().size(); ++i) s.storage()[i] = a.storage()[i] + b.storage()[i];
+  return s;
+}
+
+// A frame with every light pass (component k's light scaled by 1 + 3k, so the three differ
+// in level), Combined by Blender's identity, and the features bmfr and accumulation need.
+Frame light_frame(int w, int h, unsigned seed) {
+  Frame f;
+  f.width = w;
+  f.height = h;
+  f.path = "lights.exr";
+  Image combined(w, h, 3);
+  for (int k = 0; k < 3; ++k) {
+    Image d = random_image(w, h, 3, seed + 10 * k, 0.0f, 1.0f + 3.0f * k);
+    Image i = random_image(w, h, 3, seed + 10 * k + 1, 0.0f, 0.5f);
+    Image c = random_image(w, h, 3, seed + 10 * k + 2, 0.05f, 0.9f);
+    const Image light = sum_of(d, i);
+    for (std::size_t j = 0; j < combined.storage().size(); ++j) combined.storage()[j] += light.storage()[j] * c.storage()[j];
+    add_pass(f, kParts[k].direct, d);
+    add_pass(f, kParts[k].indirect, i);
+    add_pass(f, kParts[k].colour, c);
+  }
+  Image emit = random_image(w, h, 3, seed + 40, 0.0f, 0.3f), env = random_image(w, h, 3, seed + 41, 0.0f, 0.2f);
+  for (std::size_t j = 0; j < combined.storage().size(); ++j) combined.storage()[j] += emit.storage()[j] + env.storage()[j];
+  add_pass(f, Role::Emission, emit);
+  add_pass(f, Role::Environment, env);
+  add_pass(f, Role::Colour, combined);
+  Image n(w, h, 3, 0.0f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) n.at(x, y, x < w / 2 ? 2 : 0) = 1.0f;
+  add_pass(f, Role::Normal, n);
+  add_pass(f, Role::Position, random_image(w, h, 3, seed + 50, 0.0f, 0.05f));
+  add_pass(f, Role::Albedo, random_image(w, h, 3, seed + 51, 0.1f, 1.0f));
+  add_pass(f, Role::Motion, Image(w, h, 2, 0.0f));
+  add_pass(f, Role::Variance, Image(w, h, 1, 100.0f));
+  return f;
+}
+
+// Component k of `f` as an ordinary frame, built here: colour = direct + indirect, the features.
+Frame alone(const Frame& f, int k) {
+  Frame g;
+  g.width = f.width;
+  g.height = f.height;
+  g.path = f.path;
+  add_pass(g, Role::Colour, sum_of(f.image(kParts[k].direct), f.image(kParts[k].indirect)));
+  for (Role r : {Role::Normal, Role::Position, Role::Albedo, Role::Motion}) add_pass(g, r, f.image(r));
+  return g;
+}
+
+std::unique_ptr<Reconstruction> reconstruction(const std::string& filter,
+                                               std::vector<std::pair<std::string, std::string>> params,
+                                               bool light_passes, bool accumulate = false) {
+  if (light_passes) params.push_back({"components", "light_passes"});
+  return std::make_unique<Reconstruction>(make_committed_filter(filter, params), accumulate);
+}
+
+TEST(Components, BoxPerComponentTimesItsColourPlusEmissionAndEnvironment) {
+  const Frame f = light_frame(23, 17, 7);
+  auto rec = reconstruction("box", {{"radius", "2"}, {"step_back", "false"}}, true);
+  std::vector<ComponentImage> layers;
+  const Image beauty = rec->run(f, {}, &layers);
+  ASSERT_EQ(layers.size(), 5u);
+  for (int k = 0; k < 3; ++k) {
+    const Image want_light = box_oracle(sum_of(f.image(kParts[k].direct), f.image(kParts[k].indirect)), 2);
+    const Image& col = f.image(kParts[k].colour);
+    for (std::size_t j = 0; j < col.storage().size(); ++j) {
+      const double want = double(want_light.storage()[j]) * col.storage()[j];
+      ASSERT_NEAR(layers[std::size_t(k)].rgb.storage()[j], want, 1e-5 * std::abs(want) + 1e-7) << k << " " << j;
+    }
+  }
+  EXPECT_EQ(layers[3].rgb.storage(), f.image(Role::Emission).storage());
+  EXPECT_EQ(layers[4].rgb.storage(), f.image(Role::Environment).storage());
+  // The beauty is the layers' sum: compositors add them up and must get it back.
+  for (std::size_t j = 0; j < beauty.storage().size(); ++j) {
+    double s = 0;
+    for (const ComponentImage& l : layers) s += l.rgb.storage()[j];
+    ASSERT_NEAR(beauty.storage()[j], s, 1e-5 * std::abs(s)) << j;
+  }
+  // Not the beauty filtered whole (the colour passes vary per pixel).
+  const Image whole = reconstruction("box", {{"radius", "2"}, {"step_back", "false"}}, false)->run(f);
+  double diff = 0;
+  for (std::size_t j = 0; j < whole.storage().size(); ++j) diff = std::max(diff, double(std::abs(whole.storage()[j] - beauty.storage()[j])));
+  EXPECT_GT(diff, 1e-3);
+  bool noted = false;
+  for (const std::string& n : rec->notes()) noted = noted || n.find("components=light_passes") != std::string::npos;
+  EXPECT_TRUE(noted);
+}
+
+TEST(Components, DemodulationIsTurnedOffAndSaidSo) {
+  const Frame f = light_frame(16, 12, 3);
+  auto on = reconstruction("atrous", {{"demodulate", "true"}}, true);
+  auto off = reconstruction("atrous", {}, true);
+  EXPECT_EQ(on->run(f).storage(), off->run(f).storage());
+  EXPECT_FALSE(on->filter().params().get_bool("demodulate"));
+  bool noted = false;
+  for (const std::string& n : on->notes()) noted = noted || n.find("demodulate=true has no effect") != std::string::npos;
+  EXPECT_TRUE(noted);
+  auto bmfr = reconstruction("bmfr", {}, true);
+  EXPECT_FALSE(bmfr->filter().params().get_bool("albedo_demodulation"));
+  EXPECT_NE(bmfr->parameters_text().find("components=light_passes"), std::string::npos);
+}
+
+TEST(Components, EveryMissingLightPassIsNamedWithTheFile) {
+  Frame f = light_frame(8, 8, 1);
+  f.passes.erase(std::remove_if(f.passes.begin(), f.passes.end(), [](const Pass& p) {
+                   return p.role == Role::GlossyIndirect || p.role == Role::Environment;
+                 }),
+                 f.passes.end());
+  auto rec = reconstruction("bmfr", {}, true);
+  testutil::expect_error(Errc::MissingPass, {"GlossInd", "glossy_indirect", "Env", "environment", "lights.exr"},
+                         [&] { rec->run(f); });
+  const std::string msg = testutil::expect_error(Errc::MissingPass, [&] { rec->run(f); });
+  EXPECT_EQ(msg.find("DiffDir"), std::string::npos) << msg;
+  // Without light passes nothing is asked of them.
+  EXPECT_NO_THROW(reconstruction("box", {}, false)->run(f));
+}
+
+// One history per component: two frames through the split equal each component's own filter
+// run alone on the same two frames.
+TEST(Components, TemporalHistoriesArePerComponent) {
+  const Frame f1 = light_frame(24, 20, 11), f2 = light_frame(24, 20, 12);
+  struct Case {
+    std::string filter;
+    std::vector<std::pair<std::string, std::string>> params;
+    bool accumulate;
+  };
+  for (const Case& c : {Case{"bmfr", {{"block_size", "8"}}, false}, Case{"box", {{"radius", "0"}, {"step_back", "false"}}, true}}) {
+    SCOPED_TRACE(c.filter);
+    auto split = reconstruction(c.filter, c.params, true, c.accumulate);
+    std::vector<std::unique_ptr<Reconstruction>> single;
+    auto single_params = c.params;
+    if (c.filter == "bmfr") single_params.push_back({"albedo_demodulation", "false"});
+    for (int k = 0; k < 3; ++k) single.push_back(reconstruction(c.filter, single_params, false, c.accumulate));
+    std::vector<ComponentImage> layers;
+    for (const Frame* f : {&f1, &f2}) {
+      split->run(*f, {}, &layers);
+      for (int k = 0; k < 3; ++k) {
+        const Image light = single[std::size_t(k)]->run(alone(*f, k));
+        const Image& col = f->image(kParts[k].colour);
+        for (std::size_t j = 0; j < col.storage().size(); ++j)
+          ASSERT_EQ(layers[std::size_t(k)].rgb.storage()[j], light.storage()[j] * col.storage()[j]) << k << " " << j;
+      }
+    }
+  }
+}
+
+TEST(Components, ComponentFrameCarriesFeaturesNotTheBeautysVariance) {
+  const Frame f = light_frame(8, 6, 5);
+  const Frame g = component_frame(f, light_components()[1], 1);
+  EXPECT_EQ(g.image(Role::Colour).storage(), sum_of(f.image(Role::GlossyDirect), f.image(Role::GlossyIndirect)).storage());
+  for (Role r : {Role::Normal, Role::Position, Role::Albedo, Role::Motion}) EXPECT_TRUE(g.has(r)) << role_name(r);
+  EXPECT_FALSE(g.has(Role::Variance));
+  EXPECT_FALSE(g.has(Role::GlossyColour));
+}
+
+TEST(Components, NothingNonFiniteLeavesTheRecombination) {
+  Frame f = light_frame(6, 5, 9);
+  for (Pass& p : f.passes) {
+    if (p.role == Role::DiffuseColour) p.image.at(1, 1, 0) = testutil::kNaN;
+    if (p.role == Role::Emission) p.image.at(2, 2, 1) = testutil::kInf;
+    if (p.role == Role::GlossyColour) p.image.at(3, 3, 2) = 3e38f;
+  }
+  std::vector<ComponentImage> layers;
+  const Image beauty = reconstruction("box", {}, true)->run(f, {}, &layers);
+  for (float v : beauty.storage()) ASSERT_TRUE(std::isfinite(v));
+  for (const ComponentImage& l : layers)
+    for (float v : l.rgb.storage()) ASSERT_TRUE(std::isfinite(v)) << l.name;
+}
+
+TEST(Components, BlenderLightPassNamesHaveRoles) {
+  const std::vector<std::string> names = {"ViewLayer.DiffDir.R", "ViewLayer.DiffDir.G", "ViewLayer.DiffDir.B",
+                                          "ViewLayer.DiffCol.R", "ViewLayer.DiffCol.G", "ViewLayer.DiffCol.B",
+                                          "ViewLayer.Emit.R",    "ViewLayer.Emit.G",    "ViewLayer.Emit.B"};
+  std::vector<Role> roles;
+  for (const ChannelGroup& g : group_channels(names))
+    for (const RoleMatch& m : classify_group(g)) roles.push_back(m.role);
+  const std::vector<Role> want = {Role::DiffuseDirect, Role::Albedo, Role::DiffuseColour, Role::Emission};
+  EXPECT_EQ(roles, want);  // DiffCol: the diffuse colour pass and still the albedo of last resort
+  EXPECT_EQ(role_from_name("transmission_color"), Role::TransmissionColour);
+  EXPECT_EQ(role_from_name("environment"), Role::Environment);
+}
+
+}  // namespace
+}  // namespace mcr
