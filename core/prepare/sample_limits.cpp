@@ -79,4 +79,26 @@ void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::v
   });
 }
 
+void neighbourhood_caps(const Image& rgb, const std::vector<std::uint8_t>& flags, std::uint8_t mask, int nthreads,
+                        std::vector<float>& cap) {
+  const int w = rgb.width(), h = rgb.height();
+  cap.resize(std::size_t(w) * std::size_t(h));
+  parallel_rows(0, h, nthreads, [&](int y) {
+    for (int x = 0; x < w; ++x) {
+      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
+      double m = std::numeric_limits<double>::infinity();
+      if (flags[i] & mask) {
+        m = -std::numeric_limits<double>::infinity();
+        for (int qy = std::max(0, y - 1); qy <= std::min(h - 1, y + 1); ++qy)
+          for (int qx = std::max(0, x - 1); qx <= std::min(w - 1, x + 1); ++qx) {
+            const float* q = rgb.pixel(qx, qy);
+            if (finite3(q)) m = std::max(m, luminance(q));
+          }
+        if (!(m > -std::numeric_limits<double>::infinity())) m = std::numeric_limits<double>::infinity();  // none finite
+      }
+      cap[i] = float(std::min(m, double(std::numeric_limits<float>::max())));
+    }
+  });
+}
+
 }  // namespace mcr

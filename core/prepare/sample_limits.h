@@ -11,6 +11,7 @@
 // accumulation (temporal/accumulation.h) lets a sample through above this when its own
 // history backs it. Sums in double from window sums (kernels/window_sums.h): the
 // variance as E[Y^2] - mu^2 loses only what a bound cannot notice (sd below 1e-8 mu).
+#include <cstdint>
 #include <vector>
 
 #include "image/image.h"
@@ -20,5 +21,11 @@ namespace mcr {
 // limit: one float per pixel of rgb (resized), +inf where the window has fewer than 3
 // finite neighbours, the largest float where the bound would overflow.
 void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit);
+
+// cap: per pixel of rgb (resized), the largest finite luminance of its 3x3 neighbourhood
+// (centre included) where flags[i] & mask, +inf elsewhere: how bright a history the
+// current frame backs (a TAA-style clip, one-sided) on pixels whose history is not trusted.
+void neighbourhood_caps(const Image& rgb, const std::vector<std::uint8_t>& flags, std::uint8_t mask, int nthreads,
+                        std::vector<float>& cap);
 
 }  // namespace mcr

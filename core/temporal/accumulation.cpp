@@ -44,6 +44,7 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
           int w, float* orow, float* ncount, const AccumulationGuards& g, int xb = 0) {
   const float* lim = g.limit ? g.limit + std::size_t(y) * std::size_t(w) : nullptr;
   const float* afl = g.alpha_floor ? g.alpha_floor + std::size_t(y) * std::size_t(w) : nullptr;
+  const float* cap = g.history_cap ? g.history_cap + std::size_t(y) * std::size_t(w) : nullptr;
   const float hf = g.history_factor;
   const float* crow = crow_all + std::size_t(y) * std::size_t(w) * 3;
   const std::uint8_t* taps = r.taps.data() + std::size_t(y) * std::size_t(w);
@@ -87,8 +88,8 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
         have = true;
       }
     }
-    if (lim && afl && have && afl[x] > af) {  // responsive: no brighter than the neighbourhood backs
-      const float bound = std::max(lim[x], 0.0f);
+    if (cap && have) {  // no brighter than the current neighbourhood
+      const float bound = std::max(cap[x], 0.0f);
       const float yh = kY0 * h0 + kY1 * h1 + kY2 * h2;
       if (yh > bound) {
         const float sc = bound / yh;
@@ -141,6 +142,7 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
   const std::size_t rb = std::size_t(y) * std::size_t(w);
   const float* lim = g.limit ? g.limit + rb : nullptr;
   const float* afl = g.alpha_floor ? g.alpha_floor + rb : nullptr;
+  const float* cap = g.history_cap ? g.history_cap + rb : nullptr;
   const __m256 hfv = _mm256_set1_ps(g.history_factor), ky0 = _mm256_set1_ps(kY0), ky1 = _mm256_set1_ps(kY1),
                ky2 = _mm256_set1_ps(kY2);
   const float* crow = crow_all + rb * 3;
@@ -235,9 +237,9 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
       const __m256 rc = _mm256_cvtepi32_ps(_mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(cnt, inv), half)));
       n = _mm256_and_ps(have, _mm256_max_ps(rc, one));
     }
-    if (lim && afl) {  // row3's history cap on responsive pixels, the same operations
-      const __m256 bound = _mm256_max_ps(zero, _mm256_loadu_ps(lim + x));
-      const __m256 resp = _mm256_and_ps(have, _mm256_cmp_ps(_mm256_loadu_ps(afl + x), afv, _CMP_GT_OQ));
+    if (cap) {  // row3's history cap, the same operations
+      const __m256 bound = _mm256_max_ps(zero, _mm256_loadu_ps(cap + x));
+      const __m256 resp = have;
       const __m256 yh = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, h0), _mm256_mul_ps(ky1, h1)), _mm256_mul_ps(ky2, h2));
       const __m256 cut = _mm256_and_ps(resp, _mm256_cmp_ps(yh, bound, _CMP_GT_OQ));
       const __m256 sc = _mm256_div_ps(bound, yh);

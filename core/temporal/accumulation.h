@@ -11,9 +11,9 @@
 // RGB scaled alike (a firefly that neither its neighbours nor its own history back is cut
 // to what they do back; a highlight that persists is not), and its weight is at least
 // alpha_floor (a pixel whose history cannot be trusted, such as a mirror whose reflection
-// does not move with the surface, keeps a short one). Where alpha_floor exceeds alpha and
-// limit is given, the history itself is first cut to max(limit, 0) the same way (a
-// reflection that has slid away fades at once, as TAA clips its history).
+// does not move with the surface, keeps a short one). Before both, the history's luminance
+// is cut to max(history_cap, 0) the same way (a reflection that has slid away fades at
+// once, as TAA clips its history to the current neighbourhood).
 //
 // Non-finite input: a pixel whose new value has a NaN/Inf channel keeps its history
 // (count unchanged); with no history it is marked invalid (count 0, value 0), and
@@ -29,8 +29,9 @@ namespace mcr {
 struct AccumulationGuards {
   const float* limit = nullptr;        // w x h luminance bounds (prepare/sample_limits.h), or none
   const float* alpha_floor = nullptr;  // w x h, or none
+  const float* history_cap = nullptr;  // w x h luminance bounds of the history (+inf: none), or none
   float history_factor = 4.0f;
-  bool any() const { return limit || alpha_floor; }
+  bool any() const { return limit || alpha_floor || history_cap; }
 };
 
 // One accumulated quantity (any channel count <= 8) with its per-pixel sample count.

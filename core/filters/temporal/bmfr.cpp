@@ -66,9 +66,11 @@ const FilterInfo& BmfrFilter::static_info() {
         ParamSpec::Int("sample_limit_radius", 2, 1, 8, "half width of the sample limit's window"),
         ParamSpec::Float("sample_limit_history", 4.0, 1.0, 1e6,
                          "a sample up to this many times its history's luminance passes the sample limit"),
-        ParamSpec::Float("mirror_alpha", 0.5, 0.0, 1.0,
+        ParamSpec::Float("mirror_taa_alpha", 0.3, 0.01, 1.0,
+                         "TAA: weight floor of the current frame on mirror-like pixels (Glossy Color > 10x Diffuse Color)"),
+        ParamSpec::Float("mirror_alpha", 1.0, 0.0, 1.0,
                          "weight floor of the new sample on mirror-like pixels (Glossy Color > 10x Diffuse Color) in phases "
-                         "I and III; their phase I history is also cut to the sample limit"),
+                         "I and III; their phase I history is also cut to the brightest of the current 3x3 neighbourhood"),
         ParamSpec::Enum("features", "default", {"default", "first_order", "with_albedo", "with_depth"},
                         "feature set: default [1,n,w,w^2] (10), first_order [1,n,w] (7), with_albedo (+albedo, 13), "
                         "with_depth (+depth, 11)"),
@@ -78,7 +80,9 @@ const FilterInfo& BmfrFilter::static_info() {
         ParamSpec::Enum("taa_clip", "ycocg_variance", {"ycocg_variance", "rgb_minmax"},
                         "TAA history clipping box: ycocg_variance = 3x3 min/max intersected with mean +- taa_gamma "
                         "standard deviations in YCoCg (Karis 2014, Salvi 2016); rgb_minmax = 3x3 min/max in RGB"),
-        ParamSpec::Float("taa_gamma", 1.0, 0.1, 10.0, "TAA: half-width of the variance box in standard deviations"),
+        ParamSpec::Float("taa_gamma", 0.5, 0.1, 10.0,
+                         "TAA: half-width of the variance box in standard deviations (0.5: chosen on the anim and metal "
+                         "samples; 1 ghosted the moving highlights)"),
         ParamSpec::Enum("taa_history", "catmull_rom", {"bilinear", "catmull_rom"},
                         "TAA: history lookup (catmull_rom: sharper, Karis 2014; bilinear blurs a moving image a little "
                         "more every frame)"),
@@ -209,7 +213,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   if (classes_.mirror)
     note("bmfr: " + std::to_string(classes_.mirror) + " mirror-like pixels (Glossy Color > " +
          rounded_text(kMirrorRatio, 3) + "x Diffuse Color): not demodulated, out of the fit, history weight at least "
-         "mirror_alpha and cut to the sample limit");
+         "mirror_alpha and no brighter than the 3x3 neighbourhood");
   const Pass* ap = frame.find(Role::Albedo);
   const bool demod = params_.get_bool("albedo_demodulation") && ap;
   if (params_.get_bool("albedo_demodulation") && !ap) note("no albedo pass: the colour is fitted without demodulation");
@@ -253,9 +257,13 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     alpha_floor_.resize(n);
     for (std::size_t i = 0; i < n; ++i) alpha_floor_[i] = (classes_.flags[i] & SurfaceClasses::kMirror) ? a : 0.0f;
     guards.alpha_floor = alpha_floor_.data();
+    if (demod && !(limit_k > 0)) parallel_rows(0, h, nthreads, demod_row);  // the caps read it whole
+    neighbourhood_caps(demod ? illum_ : colour, classes_.flags, SurfaceClasses::kMirror, nthreads, history_cap_);
+    guards.history_cap = history_cap_.data();
   }
+  const bool ahead = demod && (limit_k > 0 || classes_.mirror);
   phase1_.set_guards(guards);
-  const Image& acc1 = demod ? (limit_k > 0 ? phase1_.accumulate(frame, illum_, nthreads)
+  const Image& acc1 = demod ? (ahead ? phase1_.accumulate(frame, illum_, nthreads)
                                            : phase1_.accumulate(frame, illum_, demod_row, nthreads))
                             : phase1_.accumulate(frame, colour, nthreads);
   phase1_.clear_guards();
@@ -284,7 +292,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   if (classes_.any())
     parallel_rows(0, h, nthreads, [&](int y) {
       for (std::size_t i = std::size_t(y) * std::size_t(w), e = i + std::size_t(w); i < e; ++i)
-        if (classes_.flags[i] && counts[i] > 0.0f) std::copy(acc1.data() + 3 * i, acc1.data() + 3 * i + 3, fitted_.data() + 3 * i);
+        if (fit_valid_[i] == 0.0f && counts[i] > 0.0f) std::copy(acc1.data() + 3 * i, acc1.data() + 3 * i + 3, fitted_.data() + 3 * i);
     });
   stage_ms_[kFit] = ms_since(t0);
   stage_cpu_ms_[kFit] = cpu_now_ms() - c0;
@@ -300,6 +308,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   res_.resize(3 * n);
   AccumulationGuards phase3_guards;  // mirrors keep a short history here too
   phase3_guards.alpha_floor = guards.alpha_floor;
+  phase3_guards.history_cap = guards.history_cap;
   phase3_.begin(rep, fitted_);
   parallel_rows(0, h, nthreads, [&](int y) {
     phase3_.row(y, rep, fitted_, alpha2, phase3_guards);

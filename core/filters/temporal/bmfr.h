@@ -35,7 +35,7 @@ namespace mcr {
 //     (which would spread its light over the block) and keeps its accumulated value;
 //   - a mirror-like pixel (Glossy Color >> Diffuse Color) is not divided by its albedo
 //     (the albedo of what it reflects, sample by sample), is left out of the fit, and
-//     keeps a short history (weight >= mirror_alpha, cut to the sample limit): what it
+//     keeps a short history (weight >= mirror_alpha, no brighter than its 3x3 neighbourhood): what it
 //     shows does not move with its surface.
 // Temporal: history lives in the object; reset() drops it. A size change or a camera
 // cut (more than cut_fraction of the pixels lose every reprojection tap) restarts it.
@@ -82,8 +82,12 @@ class BmfrFilter : public Filter {
   AccumulationBuffer phase3_;
   // Per-frame work buffers, kept between frames so that a steady sequence allocates nothing.
   Image illum_, albedo_, fitted_;
-  std::vector<float> fit_valid_;
-  std::vector<float> limit_;               // phase I's sample limits (prepare/sample_limits.h)           // phase I's counts, 0 where the albedo holds light
+  std::vector<float> fit_valid_;           // phase I's counts, 0 where a pixel is left out of the fit
+  std::vector<float> limit_;               // phase I's sample limits (prepare/sample_limits.h)
+  std::vector<float> alpha_floor_;         // per pixel: mirror_alpha on mirrors, else 0
+  std::vector<float> taa_alpha_;           // per pixel: mirror_taa_alpha on mirrors, else 0
+  std::vector<float> history_cap_;         // per pixel: the 3x3 brightest on mirrors, else +inf
+  SurfaceClasses classes_;                 // prepare/surface_classes.h, this frame's
   std::vector<float> res_;                 // phase III result (remodulated), planar RGB
   std::vector<float> taa_hist_, taa_next_;  // TAA history (the previous output), planar RGB
   int taa_w_ = 0, taa_h_ = 0;              // size of taa_hist_ (0: none)

@@ -381,9 +381,11 @@ MCR_INLINE void taa_row(const TaaJob& J, TaaRow& T, int y) {
       s[2] = b;
     }
     const VI<W> ok = load<W>(T.ok + x, n) != zero;
+    const V alpha = J.s.alpha_floor ? vmax(load<W>(J.s.alpha_floor + rb + x, n), simd::splat<W>(J.s.alpha))
+                                    : simd::splat<W>(J.s.alpha);  // std::max(alpha, floor)
     for (int k = 0; k < 3; ++k) {
       const V q = load<W>(J.cur[k] + rb + x, n);
-      const V o = s[k] + J.s.alpha * (q - s[k]);
+      const V o = s[k] + alpha * (q - s[k]);
       store<W>(nx[k] + x, (ok & (vabs<W>(o) <= big)) ? o : q, n);
     }
   });
@@ -435,6 +437,12 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
     s.catmull_rom = params_.get_enum("taa_history") == "catmull_rom";
     s.ycocg = params_.get_enum("taa_clip") == "ycocg_variance";
     s.gamma = float(params_.get_float("taa_gamma"));
+    if (classes_.mirror) {  // mirrors: the blend weight at least mirror_taa_alpha
+      const float a = float(params_.get_float("mirror_taa_alpha"));
+      taa_alpha_.resize(n);
+      for (std::size_t i = 0; i < n; ++i) taa_alpha_[i] = (classes_.flags[i] & SurfaceClasses::kMirror) ? a : 0.0f;
+      s.alpha_floor = taa_alpha_.data();
+    }
     taa_next_.resize(3 * n);
     temporal_antialias(s, rep, res_.data(), taa_hist_.data(), taa_next_.data(), nthreads, &out, roi);
     std::swap(taa_hist_, taa_next_);

@@ -13,6 +13,7 @@ struct TaaSettings {
   bool catmull_rom = true;  // taa_history: Catmull-Rom lookup, else bilinear over the taps inside the frame
   bool ycocg = true;        // taa_clip: ycocg_variance, else rgb_minmax
   float gamma = 1.0f;       // taa_gamma: half-width of the variance box in standard deviations
+  const float* alpha_floor = nullptr;  // per pixel (w x h): the blend weight is at least this, or none
 };
 
 // current, history, next: planar RGB (three planes of rep.width x rep.height). The history
