@@ -95,8 +95,15 @@ Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options, std
 Image Reconstruction::run_stage(Stage& stage, Frame& frame, const ExecOptions& options) {
   if (!accumulate_) return stage.filter->execute(frame, options);
   Image& colour = frame.passes[std::size_t(&frame.get(Role::Colour) - frame.passes.data())].image;
-  const Image& acc = stage.accumulator.accumulate(frame, colour.channels() == 3 ? colour : colour.channel_range(0, 3),
-                                                  options.nthreads);
+  const Image rgb = colour.channels() == 3 ? Image() : colour.channel_range(0, 3);
+  const Image& signal = colour.channels() == 3 ? colour : rgb;
+  classify_surfaces(frame, options.nthreads, stage.classes);
+  stage.accumulator.set_guards(stage.guards.build(signal, stage.classes, HistoryGuardSettings{}, options.nthreads));
+  const Image& acc = stage.accumulator.accumulate(frame, signal, options.nthreads);
+  stage.accumulator.clear_guards();
+  if (stage.classes.mirror)
+    notes_.push_back("accumulation: " + std::to_string(stage.classes.mirror) +
+                     " mirror-like pixels (Glossy Color > 10x Diffuse Color) keep no history");
   const std::size_t ch = std::size_t(colour.channels());
   for (std::size_t i = 0; i < acc.pixel_count(); ++i)
     for (std::size_t c = 0; c < 3; ++c) colour.data()[i * ch + c] = acc.data()[i * 3 + c];

@@ -4,7 +4,9 @@
 // reprojected cumulative-then-exponential average of the noisy colour, with its own
 // history across the frames of a run) before the filter, which then sees a frame whose
 // colour pass holds the accumulated RGB (alpha and other channels kept). Only the
-// pipeline combines stages; the filter knows nothing of it.
+// pipeline combines stages; the filter knows nothing of it. The accumulation is guarded as
+// bmfr's phase I is (prepare/history_guards.h, defaults): fireflies are cut before they
+// enter the history, and mirror-like pixels keep none.
 //
 // With components=light_passes (pipeline/components.h) each light component runs through
 // its own accumulation and filter (one history per component); the filter's demodulation
@@ -23,6 +25,8 @@
 
 #include "filters/filter.h"
 #include "pipeline/components.h"
+#include "prepare/history_guards.h"
+#include "prepare/surface_classes.h"
 #include "temporal/accumulation.h"
 
 namespace mcr {
@@ -64,6 +68,8 @@ class Reconstruction {
   struct Stage {
     std::unique_ptr<Filter> filter;
     TemporalAccumulator accumulator;
+    SurfaceClasses classes;  // this frame's (prepare/surface_classes.h)
+    HistoryGuards guards;    // the accumulation's (prepare/history_guards.h)
   };
   // Accumulates frame's colour in place when asked, runs the stage's filter.
   Image run_stage(Stage& stage, Frame& frame, const ExecOptions& options);

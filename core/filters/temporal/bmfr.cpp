@@ -8,7 +8,7 @@
 #include <ctime>
 
 #include "prepare/demodulation.h"
-#include "prepare/sample_limits.h"
+#include "prepare/history_guards.h"
 #include "prepare/surface_classes.h"
 #include "util/avx2_shuffles.h"
 #include "util/error.h"
@@ -244,24 +244,14 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // Phase I (reprojection fused with the accumulation), with its guards
   // (temporal/accumulation.h): the sample limit needs the new illumination whole first
   // (its windows), so the demodulation then runs ahead.
-  const double limit_k = params_.get_float("sample_limit_k");
-  AccumulationGuards guards;
-  if (limit_k > 0) {
-    if (demod) parallel_rows(0, h, nthreads, demod_row);
-    firefly_limits(demod ? illum_ : colour, int(params_.get_int("sample_limit_radius")), limit_k, nthreads, limit_);
-    guards.limit = limit_.data();
-    guards.history_factor = float(params_.get_float("sample_limit_history"));
-  }
-  if (classes_.mirror) {
-    const float a = float(params_.get_float("mirror_alpha"));
-    alpha_floor_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) alpha_floor_[i] = (classes_.flags[i] & SurfaceClasses::kMirror) ? a : 0.0f;
-    guards.alpha_floor = alpha_floor_.data();
-    if (demod && !(limit_k > 0)) parallel_rows(0, h, nthreads, demod_row);  // the caps read it whole
-    neighbourhood_caps(demod ? illum_ : colour, classes_.flags, SurfaceClasses::kMirror, nthreads, history_cap_);
-    guards.history_cap = history_cap_.data();
-  }
-  const bool ahead = demod && (limit_k > 0 || classes_.mirror);
+  HistoryGuardSettings gs;
+  gs.limit_k = params_.get_float("sample_limit_k");
+  gs.limit_radius = int(params_.get_int("sample_limit_radius"));
+  gs.history_factor = params_.get_float("sample_limit_history");
+  gs.mirror_alpha = params_.get_float("mirror_alpha");
+  const bool ahead = demod && (gs.limit_k > 0 || classes_.mirror);
+  if (ahead) parallel_rows(0, h, nthreads, demod_row);
+  const AccumulationGuards guards = history_guards_.build(demod ? illum_ : colour, classes_, gs, nthreads);
   phase1_.set_guards(guards);
   const Image& acc1 = demod ? (ahead ? phase1_.accumulate(frame, illum_, nthreads)
                                            : phase1_.accumulate(frame, illum_, demod_row, nthreads))

@@ -3,6 +3,7 @@
 #include <cstdint>
 
 #include "filters/filter.h"
+#include "prepare/history_guards.h"
 #include "prepare/surface_classes.h"
 #include "temporal/accumulation.h"
 
@@ -83,10 +84,8 @@ class BmfrFilter : public Filter {
   // Per-frame work buffers, kept between frames so that a steady sequence allocates nothing.
   Image illum_, albedo_, fitted_;
   std::vector<float> fit_valid_;           // phase I's counts, 0 where a pixel is left out of the fit
-  std::vector<float> limit_;               // phase I's sample limits (prepare/sample_limits.h)
-  std::vector<float> alpha_floor_;         // per pixel: mirror_alpha on mirrors, else 0
   std::vector<float> taa_alpha_;           // per pixel: mirror_taa_alpha on mirrors, else 0
-  std::vector<float> history_cap_;         // per pixel: the 3x3 brightest on mirrors, else +inf
+  HistoryGuards history_guards_;           // phase I's (prepare/history_guards.h)
   SurfaceClasses classes_;                 // prepare/surface_classes.h, this frame's
   std::vector<float> res_;                 // phase III result (remodulated), planar RGB
   std::vector<float> taa_hist_, taa_next_;  // TAA history (the previous output), planar RGB

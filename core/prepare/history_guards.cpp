@@ -1,0 +1,28 @@
+#include "prepare/history_guards.h"
+
+#include "prepare/sample_limits.h"
+
+namespace mcr {
+
+AccumulationGuards HistoryGuards::build(const Image& signal, const SurfaceClasses& classes, const HistoryGuardSettings& s,
+                                        int nthreads) {
+  AccumulationGuards g;
+  g.history_factor = float(s.history_factor);
+  if (s.limit_k > 0) {
+    firefly_limits(signal, s.limit_radius, s.limit_k, nthreads, limit_);
+    g.limit = limit_.data();
+  }
+  alpha_floor_.clear();
+  if (classes.mirror && s.mirror_alpha > 0) {
+    const std::size_t n = classes.flags.size();
+    alpha_floor_.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
+      alpha_floor_[i] = (classes.flags[i] & SurfaceClasses::kMirror) ? float(s.mirror_alpha) : 0.0f;
+    g.alpha_floor = alpha_floor_.data();
+    neighbourhood_caps(signal, classes.flags, SurfaceClasses::kMirror, nthreads, cap_);
+    g.history_cap = cap_.data();
+  }
+  return g;
+}
+
+}  // namespace mcr

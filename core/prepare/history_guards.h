@@ -1,0 +1,39 @@
+#pragma once
+// The per-pixel guards of a temporal accumulation (temporal/accumulation.h) built from a
+// frame: one rule for bmfr's phase I and the pipeline's `--accumulate` (issue 15).
+//   - limit: a new sample's luminance may not exceed its neighbours' mean + limit_k
+//     deviations (prepare/sample_limits.h) unless its own history backs it
+//     (history_factor x the history's luminance): a firefly does not enter the history;
+//   - on mirror-like pixels (prepare/surface_classes.h) the new sample's weight is at
+//     least mirror_alpha and the history is no brighter than the current 3x3
+//     neighbourhood's brightest: what a mirror shows does not move with its surface.
+// The buffers are kept between frames (a sequence allocates once).
+#include <vector>
+
+#include "image/image.h"
+#include "prepare/surface_classes.h"
+#include "temporal/accumulation.h"
+
+namespace mcr {
+
+struct HistoryGuardSettings {
+  double limit_k = 3.0;        // 0: no sample limit
+  int limit_radius = 2;
+  double history_factor = 4.0;
+  double mirror_alpha = 1.0;   // 0: mirrors as any pixel
+};
+
+class HistoryGuards {
+ public:
+  // signal: the RGB that is about to be accumulated (the frame's size). The result points
+  // into this object: valid until the next build().
+  AccumulationGuards build(const Image& signal, const SurfaceClasses& classes, const HistoryGuardSettings& s,
+                           int nthreads);
+  // Per pixel mirror_alpha on mirrors, else 0 (valid after a build() that found mirrors).
+  const float* alpha_floor() const { return alpha_floor_.empty() ? nullptr : alpha_floor_.data(); }
+
+ private:
+  std::vector<float> limit_, alpha_floor_, cap_;
+};
+
+}  // namespace mcr
