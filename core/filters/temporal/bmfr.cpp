@@ -103,6 +103,10 @@ const FilterInfo& BmfrFilter::static_info() {
         ParamSpec::Float("cut_fraction", 0.9, 0.0, 1.0,
                          "camera cut: history restarts when more than this fraction of pixels lose every tap"),
     }, i.steps);
+    // Its phase I sample limit does the firefly step's job, on the accumulated signal and at
+    // a fraction of its cost (separable sums, not a two-pass 7x7 window per pixel).
+    for (ParamSpec& p : i.params)
+      if (p.name == "firefly_k") p.default_value = 0.0;
     i.required = {Role::Colour, Role::Normal, Role::Position};
     i.optional = {Role::Albedo, Role::Motion, Role::Depth};
     i.temporal = true;
