@@ -76,7 +76,7 @@ class ComponentsCliTest(unittest.TestCase):
         proc = self.denoise("-f", "box", "--set", "components=light_passes", broken, "-o", self.path("o.exr"),
                             check=False)
         self.assertEqual(proc.returncode, 2, proc.stderr)
-        for text in ("GlossInd", "Env", "no_gloss.exr", "components=light_passes"):
+        for text in ("GlossInd (glossy_indirect)", "Env (environment)", "no_gloss.exr", "components=light_passes"):
             self.assertIn(text, proc.stderr)
         self.assertNotIn("DiffDir", proc.stderr)
         self.assertFalse(os.path.exists(self.path("o.exr")))
