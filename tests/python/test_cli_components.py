@@ -90,6 +90,13 @@ class ComponentsCliTest(unittest.TestCase):
         self.assertEqual(proc.returncode, 2, proc.stderr)
         for text in ("lights", "beauty", "light_passes"):
             self.assertIn(text, proc.stderr)
+        # Half buffers are merged by their colour only: refused rather than half the light passes.
+        other = self.path("other_half.exr")
+        lp.write_multilayer(other, lp.make_passes(seed=2))
+        proc = self.denoise("-f", "box", "--set", "components=light_passes", self.input, "--half", other,
+                            "-o", self.path("o.exr"), check=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        self.assertIn("other_half.exr", proc.stderr)
         self.assertFalse(os.path.exists(self.path("o.exr")))
 
     def test_every_filter_takes_components(self):
