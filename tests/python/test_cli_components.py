@@ -57,7 +57,7 @@ class ComponentsCliTest(unittest.TestCase):
                 for name, short in lp.COMPONENTS:
                     light = self.passes[short + "Dir"] + self.passes[short + "Ind"]
                     single = self.path("%s_%s.exr" % (filt, short))
-                    lp.write_single(single, light, self.passes)
+                    lp.write_single(single, light, self.passes, self.passes[short + "Col"])
                     self.denoise("-f", filt, single, "-o", single + ".out.exr")
                     want = tu.read_channels(single + ".out.exr", RGB) * self.passes[short + "Col"]
                     np.testing.assert_allclose(layers[name], want, rtol=1e-6, atol=1e-7, err_msg=name)
