@@ -1,8 +1,10 @@
+#include <algorithm>
 #include <iostream>
 
 #include "commands.h"
 #include "io/frame_reader.h"
 #include "json_views.h"
+#include "pipeline/components.h"
 #include "pipeline/filter_catalog.h"
 #include "pipeline/reconstruction.h"
 
@@ -64,7 +66,9 @@ int run_info(const InfoArgs& a) {
     for (std::size_t i = 0; i < p.channels.size(); ++i) std::cout << (i ? " " : "") << p.channels[i];
     std::cout << "]";
     if (p.space != Space::None) std::cout << " " << space_name(p.space) << " space";
-    if (frame.find(p.role, Prefer::Feature) == &p) std::cout << " (used by feature filters)";
+    const auto light = light_pass_roles();
+    if (std::find(light.begin(), light.end(), p.role) != light.end()) std::cout << " (light pass: components=light_passes)";
+    else if (frame.find(p.role, Prefer::Feature) == &p) std::cout << " (used by feature filters)";
     else if (frame.find(p.role, Prefer::Geometry) == &p) std::cout << " (used for geometry)";
     std::cout << "\n";
   }

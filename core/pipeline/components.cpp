@@ -115,7 +115,6 @@ Frame component_frame(const Frame& frame, const LightComponent& component, int n
       case Role::Normal:
       case Role::Position:
       case Role::Depth:
-      case Role::Albedo:
       case Role::Motion:
       case Role::SecondPosition:
       case Role::SecondNormal:
@@ -124,6 +123,12 @@ Frame component_frame(const Frame& frame, const LightComponent& component, int n
       default: break;  // colour, variance (the beauty's), the light passes
     }
   }
+  // The component's colour pass is its albedo feature (edge-stopping, guides): noise-free, it
+  // tells metal from dielectric, where Blender's Denoising Albedo follows mirror bounces.
+  Pass albedo = frame.get(component.colour);
+  albedo.role = Role::Albedo;
+  albedo.priority = 3;
+  out.passes.push_back(std::move(albedo));
   Pass light;
   light.role = Role::Colour;
   light.name = direct.name + "+" + indirect.name;

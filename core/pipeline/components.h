@@ -51,9 +51,12 @@ std::vector<Role> light_pass_roles();
 // file: Blender writes each pass it was asked for, so all must be there.
 void check_light_passes(const Frame& frame);
 
-// The frame a component's filter sees: colour = direct + indirect (RGB), plus the frame's
-// feature passes (normal, position, depth, albedo, motion, second hit, sample count,
-// alpha). Not the variance pass: it measures the beauty's noise, not this light's.
+// The frame a component's filter sees: colour = direct + indirect (RGB), albedo = the
+// component's colour pass, plus the frame's other feature passes (normal, position, depth,
+// motion, second hit, sample count, alpha). The colour pass, not Blender's Denoising Albedo,
+// which follows mirror bounces and holds highlights (~200 at a sun's reflection at 1 spp);
+// the colour pass is smooth and tells metal from dielectric. Not the variance pass: it
+// measures the beauty's noise, not this light's.
 Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads);
 
 struct ComponentImage {

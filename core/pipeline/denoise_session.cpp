@@ -28,6 +28,12 @@ DenoiseSession::DenoiseSession(const std::string& filter,
 StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
                                const WriteOptions& write, const ExecOptions& exec) {
   if (write.keep_components) check_keep_components(reconstruction_.filter().params());
+  if (!read.second_half.empty() && reconstruction_.light_passes())
+    // Two half buffers are merged by their colour pass only (io/half_buffers.h): the light
+    // passes would come from the first half alone.
+    throw Error(Errc::InvalidArgument, "--half '" + read.second_half + "' with components=light_passes: the halves' "
+                                       "light passes are not merged; denoise one render with components=light_passes, "
+                                       "or the halves with components=beauty");
   if (!output.empty()) {
     // Every front end's file run passes here: the output is checked against every
     // input of the run (the render and any loose pass file) before anything is read.

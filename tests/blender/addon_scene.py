@@ -153,6 +153,30 @@ def case_passes():
     result["after_operator_box"] = toggles(scene)
 
 
+def light_toggles(scene):
+    import mcrecon_addon.passes as passes
+    vl = scene.view_layers[0]
+    return {a: getattr(vl, a) for _, a in passes.LIGHT_TOGGLES.values()}
+
+
+def case_light_passes():
+    """'Denoise light passes' turns the light passes on (and leaves them on when turned off);
+    with 'Keep components' the render's output holds the component layers."""
+    scene = room_scene()
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = "box"
+    result["light_before"] = light_toggles(scene)
+    mc.light_passes = True
+    result["light_on"] = light_toggles(scene)
+    mc.keep_components = True
+    render(scene, os.path.join(OUT, "noisy"), 4, 11)
+    result["noisy"] = written(scene)
+    result["message"] = mc.last_message
+    mc.light_passes = False
+    result["light_after_off"] = light_toggles(scene)
+
+
 def anim_scene(filter_name, accumulate=False):
     """The anim sample scene at test size, frames 1-4, with the add-on on."""
     import anim
@@ -271,7 +295,7 @@ enable_addon()
 {"render_box": lambda: case_render("box"), "render_bilateral": lambda: case_render("bilateral"),
  "render_auto": lambda: case_render("auto"),
  "passes": case_passes, "anim_bmfr": case_anim, "anim_accumulate": case_anim_accumulate,
- "errors": case_errors,
+ "errors": case_errors, "light_passes": case_light_passes,
  "composite": case_composite, "install_zip": case_install_zip}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

@@ -134,6 +134,32 @@ def check_render(filter_name, box_radius=None):
         assert e_den < 0.8 * e_box, f"{filter_name} is not clearly better than a box blur of its radius"
 
 
+def check_light_passes():
+    """The add-on's 'Denoise light passes' enables every light pass on the view layer and its
+    output (with 'Keep components') is `mcrecon denoise --set components=light_passes
+    --keep-components` of the saved render bit for bit, its component layers summing to R,G,B."""
+    r, log = run_blender()
+    assert not any(r["light_before"].values()), r["light_before"]
+    assert all(r["light_on"].values()), r["light_on"]
+    assert all(r["light_after_off"].values()), "light passes were turned off: " + str(r["light_after_off"])
+    noisy = r["noisy"]
+    den = os.path.splitext(noisy)[0] + "_denoised.exr"
+    assert os.path.exists(den), f"missing {den}\n{log[-3000:]}"
+    assert "components=light_passes" in log, log[-3000:]
+    want = cli_denoise(noisy, os.path.join(OUT, "cli_denoised.exr"), "box", "components=light_passes",
+                       extra=("--keep-components",))
+    (got_names, got), (want_names, want_px) = all_channels(den), all_channels(want)
+    assert got_names == want_names, (got_names, want_names)
+    assert np.array_equal(got.view(np.uint32), want_px.view(np.uint32)), "the add-on's output differs from the CLI's"
+    layers = [n for n in got_names if ".Denoised." in n and n.endswith(".R")]
+    assert len(layers) == 5, got_names
+    for c in "RGB":
+        total = sum(got[:, :, got_names.index(n[:-1] + c)] for n in layers)
+        beauty = got[:, :, got_names.index(c)]
+        assert np.all(np.abs(total - beauty) <= 1e-5 * np.abs(beauty) + 1e-30), c
+    print(f"light passes: {len(got_names)} channels, components sum to the beauty")
+
+
 def bilateral_radius():
     """The window radius of bilateral's default settings: ceil(3 spatial_sigma)."""
     sigma = {p["name"]: p for p in mcrecon.filter_info("bilateral")["parameters"]}["spatial_sigma"]["default"]
@@ -293,6 +319,6 @@ def check_install_zip():
 {"render_box": lambda: check_render("box"), "render_auto": lambda: check_render("auto"),
  "render_bilateral": lambda: check_render("bilateral", box_radius=bilateral_radius()),
  "passes": check_passes, "anim_bmfr": check_anim, "anim_accumulate": check_anim_accumulate,
- "errors": check_errors,
+ "errors": check_errors, "light_passes": check_light_passes,
  "composite": check_composite, "install_zip": check_install_zip}[CASE]()
 print("OK")

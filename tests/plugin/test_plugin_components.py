@@ -53,7 +53,7 @@ class PluginComponentsTest(unittest.TestCase):
         lp.write_multilayer(broken, self.passes, leave_out=("Env",))
         proc = oiiotool(broken + ".mcrecon?filter=box&components=light_passes", "-o", self.path("o.exr"))
         self.assertNotEqual(proc.returncode, 0)
-        self.assertIn("Env", proc.stdout + proc.stderr)
+        self.assertIn("Env (environment)", proc.stdout + proc.stderr)
         self.assertIn("components=light_passes", proc.stdout + proc.stderr)
 
 

@@ -64,13 +64,13 @@ def write_multilayer(path, passes, leave_out=()):
     tu.write_exr(path, np.stack(planes, axis=-1), names)
 
 
-def write_single(path, rgb, passes):
-    """A file whose Combined is `rgb`, with the same feature passes (DiffCol: the albedo the
-    multilayer file's filters see): the oracle's input."""
-    tu.write_exr(path, np.concatenate([rgb, passes["Normal"], passes["Depth"], passes["DiffCol"]], axis=-1),
+def write_single(path, rgb, passes, albedo):
+    """A file whose Combined is `rgb`, with the same feature passes and `albedo` as its albedo
+    (a component's filter sees its colour pass as albedo): the oracle's input."""
+    tu.write_exr(path, np.concatenate([rgb, passes["Normal"], passes["Depth"], albedo], axis=-1),
                  ["%s.Combined.%s" % (LAYER, c) for c in "RGB"] +
                  ["%s.Normal.%s" % (LAYER, c) for c in "XYZ"] + [LAYER + ".Depth.Z"] +
-                 ["%s.DiffCol.%s" % (LAYER, c) for c in "RGB"])
+                 ["%s.Denoising Albedo.%s" % (LAYER, c) for c in "RGB"])
 
 
 def component_layer_channels(name, layer=LAYER):

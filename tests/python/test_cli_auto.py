@@ -56,7 +56,8 @@ class AutoCliTest(unittest.TestCase):
         self.assertEqual(auto["required_passes"], ["colour"])
         self.assertFalse(auto["temporal"])
         params = {p["name"]: p for p in auto["parameters"]}
-        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain"})
+        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "components"})
+        self.assertEqual(params.pop("components")["choices"], ["beauty", "light_passes"])  # every filter's
         for p in params.values():
             self.assertEqual(p["type"], "float")
             self.assertLessEqual(p["min"], p["default"])

@@ -57,7 +57,7 @@ class ComponentsCliTest(unittest.TestCase):
                 for name, short in lp.COMPONENTS:
                     light = self.passes[short + "Dir"] + self.passes[short + "Ind"]
                     single = self.path("%s_%s.exr" % (filt, short))
-                    lp.write_single(single, light, self.passes)
+                    lp.write_single(single, light, self.passes, self.passes[short + "Col"])
                     self.denoise("-f", filt, single, "-o", single + ".out.exr")
                     want = tu.read_channels(single + ".out.exr", RGB) * self.passes[short + "Col"]
                     np.testing.assert_allclose(layers[name], want, rtol=1e-6, atol=1e-7, err_msg=name)
@@ -76,7 +76,7 @@ class ComponentsCliTest(unittest.TestCase):
         proc = self.denoise("-f", "box", "--set", "components=light_passes", broken, "-o", self.path("o.exr"),
                             check=False)
         self.assertEqual(proc.returncode, 2, proc.stderr)
-        for text in ("GlossInd", "Env", "no_gloss.exr", "components=light_passes"):
+        for text in ("GlossInd (glossy_indirect)", "Env (environment)", "no_gloss.exr", "components=light_passes"):
             self.assertIn(text, proc.stderr)
         self.assertNotIn("DiffDir", proc.stderr)
         self.assertFalse(os.path.exists(self.path("o.exr")))
@@ -90,6 +90,13 @@ class ComponentsCliTest(unittest.TestCase):
         self.assertEqual(proc.returncode, 2, proc.stderr)
         for text in ("lights", "beauty", "light_passes"):
             self.assertIn(text, proc.stderr)
+        # Half buffers are merged by their colour only: refused rather than half the light passes.
+        other = self.path("other_half.exr")
+        lp.write_multilayer(other, lp.make_passes(seed=2))
+        proc = self.denoise("-f", "box", "--set", "components=light_passes", self.input, "--half", other,
+                            "-o", self.path("o.exr"), check=False)
+        self.assertEqual(proc.returncode, 2, proc.stderr)
+        self.assertIn("other_half.exr", proc.stderr)
         self.assertFalse(os.path.exists(self.path("o.exr")))
 
     def test_every_filter_takes_components(self):

@@ -68,14 +68,16 @@ Frame light_frame(int w, int h, unsigned seed) {
   return f;
 }
 
-// Component k of `f` as an ordinary frame, built here: colour = direct + indirect, the features.
+// Component k of `f` as an ordinary frame, built here: colour = direct + indirect, albedo =
+// its colour pass, the other features.
 Frame alone(const Frame& f, int k) {
   Frame g;
   g.width = f.width;
   g.height = f.height;
   g.path = f.path;
   add_pass(g, Role::Colour, sum_of(f.image(kParts[k].direct), f.image(kParts[k].indirect)));
-  for (Role r : {Role::Normal, Role::Position, Role::Albedo, Role::Motion}) add_pass(g, r, f.image(r));
+  add_pass(g, Role::Albedo, f.image(kParts[k].colour));
+  for (Role r : {Role::Normal, Role::Position, Role::Motion}) add_pass(g, r, f.image(r));
   return g;
 }
 
@@ -156,7 +158,7 @@ TEST(Components, TemporalHistoriesArePerComponent) {
     std::vector<std::pair<std::string, std::string>> params;
     bool accumulate;
   };
-  for (const Case& c : {Case{"bmfr", {{"block_size", "8"}}, false}, Case{"box", {{"radius", "0"}, {"step_back", "false"}}, true}}) {
+  for (const Case& c : {Case{"bmfr", {{"block_size", "8"}, {"features", "with_albedo"}}, false}, Case{"box", {{"radius", "0"}, {"step_back", "false"}}, true}}) {
     SCOPED_TRACE(c.filter);
     auto split = reconstruction(c.filter, c.params, true, c.accumulate);
     std::vector<std::unique_ptr<Reconstruction>> single;
@@ -176,11 +178,12 @@ TEST(Components, TemporalHistoriesArePerComponent) {
   }
 }
 
-TEST(Components, ComponentFrameCarriesFeaturesNotTheBeautysVariance) {
+TEST(Components, ComponentFrameCarriesFeaturesItsColourAsAlbedoNotTheBeautysVariance) {
   const Frame f = light_frame(8, 6, 5);
   const Frame g = component_frame(f, light_components()[1], 1);
   EXPECT_EQ(g.image(Role::Colour).storage(), sum_of(f.image(Role::GlossyDirect), f.image(Role::GlossyIndirect)).storage());
   for (Role r : {Role::Normal, Role::Position, Role::Albedo, Role::Motion}) EXPECT_TRUE(g.has(r)) << role_name(r);
+  EXPECT_EQ(g.image(Role::Albedo).storage(), f.image(Role::GlossyColour).storage());  // not Denoising Albedo
   EXPECT_FALSE(g.has(Role::Variance));
   EXPECT_FALSE(g.has(Role::GlossyColour));
 }
