@@ -44,11 +44,17 @@ SCENES = {
                           "over it), a brushed-steel torus and a glass ball on a glossy checkered "
                           "floor before a low brick wall; indirect clamp off (fireflies); the "
                           "noisy frames carry Blender's light passes."),
+    "chrome": ("sequence", "16-frame keyframed dolly (left and in, panning along) past a chrome "
+                           "tap, kettle and bevelled toaster, a brushed-steel tray, a glass and a "
+                           "mug on a wooden counter before glossy tiles, lit by one small, strong "
+                           "point lamp (its highlights slide over the chrome) and a dim world; "
+                           "indirect clamp off; held out: never used to choose settings."),
 }
-ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal"]
+ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
-         "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report"}
+         "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
+         "chrome": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
 HALVES = {"sunlit": [16], "showroom": [16], "wall": [16]}
 
@@ -76,6 +82,9 @@ def parse_args():
     p.add_argument("--metal-size", default="256x144", help="WxH of the metal sequence")
     p.add_argument("--metal-ref-spp", type=int, default=512,
                    help="reference spp per frame of the metal sequence")
+    p.add_argument("--chrome-size", default="192x108", help="WxH of the chrome sequence")
+    p.add_argument("--chrome-ref-spp", type=int, default=512,
+                   help="reference spp per frame of the chrome sequence")
     p.add_argument("--threads", type=int, default=0, help="Cycles threads (0 = all cores)")
     p.add_argument("--blender", default=os.environ.get("BLENDER", "blender"))
     return p.parse_args()
@@ -91,6 +100,8 @@ def seq_settings(args, name):
     """(WxH, reference spp) of a sequence: each has its own options."""
     if name == "metal":
         return args.metal_size, args.metal_ref_spp
+    if name == "chrome":
+        return args.chrome_size, args.chrome_ref_spp
     return args.anim_size, args.anim_ref_spp
 
 
