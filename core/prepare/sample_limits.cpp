@@ -96,7 +96,7 @@ void neighbourhood_caps(const Image& rgb, const std::vector<std::uint8_t>& flags
           }
         if (!(m > -std::numeric_limits<double>::infinity())) m = std::numeric_limits<double>::infinity();  // none finite
       }
-      cap[i] = float(std::min(m, double(std::numeric_limits<float>::max())));
+      cap[i] = std::isinf(m) ? std::numeric_limits<float>::infinity() : float(std::min(m, double(std::numeric_limits<float>::max())));
     }
   });
 }
