@@ -157,7 +157,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     throw Error(Errc::Internal, "filter '" + info_.name + "' returned an output of another size");
   repaired_ = finish(prepared_, input, roi, nthreads, out);
   if (repaired_) note(std::to_string(repaired_) + " non-finite output values replaced by 0");
-  if (info_.steps.step_back && params_.get_bool("step_back")) {
+  if (info_.steps.step_back && params_.get_bool("step_back") && step_back_applies()) {
     const Pass* variance = prepared_.frame->find(Role::Variance);
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
                                        nthreads, out, variance ? &variance->image : nullptr);

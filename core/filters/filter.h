@@ -104,6 +104,10 @@ class Filter {
   // every pixel of the roi: the base class then passes the colour buffer itself as `out`
   // (the same object: no copy of the frame).
   virtual bool run_in_place() const { return false; }
+  // Whether the step back (prepare/step_back.h) applies to the result run() just gave: its
+  // limits assume a spatial estimate from this frame's input (a temporal filter's output
+  // built from history may lie outside this frame's local range, rightly).
+  virtual bool step_back_applies() const { return true; }
   // During run(): the demodulation divisor (RGB, valid inside the roi), null when the
   // colour was not demodulated.
   const Image* demodulation_divisor() const { return prepared_.divisor.empty() ? nullptr : &prepared_.divisor; }

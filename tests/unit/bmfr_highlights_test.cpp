@@ -122,5 +122,23 @@ TEST(BmfrHighlights, AReflectionThatSlidesAwayDoesNotTrail) {
   }
 }
 
+TEST(BmfrHighlights, OnlyAFrameWithoutHistoryStepsBack) {
+  // A still is a spatial estimate: the step back guards it as every image filter's. A
+  // frame built from history is not (its limits assume this frame's local range).
+  auto f = bmfr();
+  auto stepped = [&] {
+    for (const std::string& n : f->notes())
+      if (n.rfind("step_back:", 0) == 0) return true;
+    return false;
+  };
+  f->execute(flip_frame(0, true));
+  EXPECT_TRUE(stepped());
+  f->execute(flip_frame(1, true));
+  EXPECT_FALSE(stepped());
+  f->reset();
+  f->execute(flip_frame(2, true));
+  EXPECT_TRUE(stepped());
+}
+
 }  // namespace
 }  // namespace mcr

@@ -192,7 +192,8 @@ TEST(ConstantFeatureSkip, BmfrLeavesAConstantNormalOutOfTheRegression) {
   pass_image(g, Role::Normal).pixel(1, 1)[0] = 0.3f;
   auto run = [](const Frame& fr) {
     auto bm = make_filter("bmfr");
-    for (const auto& [k, v] : Params{{"epsilon", 0.0}, {"offsets", false}, {"taa", false}, {"block_size", std::int64_t(16)}})
+    for (const auto& [k, v] : Params{{"epsilon", 0.0}, {"offsets", false}, {"taa", false}, {"block_size", std::int64_t(16)},
+                                     {"step_back", false}})  // the regression itself
       bm->set(k, v);
     bm->commit();
     Result r;

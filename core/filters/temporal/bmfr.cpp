@@ -51,7 +51,7 @@ const FilterInfo& BmfrFilter::static_info() {
     // Demodulation is bmfr's own (fused into phase I, remodulated before TAA): it takes
     // every preparation step but that one.
     i.steps.demodulate = false;
-    i.steps.step_back = false;  // the temporal output's own safeguards: issue 15
+    i.steps.step_back = true;  // on a still (a frame without history) only: step_back_applies()
     i.params = with_preparation_params({
         ParamSpec::Int("block_size", 0, 0, 128,
                        "side of the square regression blocks in pixels (8..128); 0 = auto: 32 (the paper's) when the "
@@ -157,6 +157,7 @@ void BmfrFilter::reset() {
   taa_w_ = taa_h_ = 0;
   frame_index_ = 0;
   last_cut_ = false;
+  had_history_ = false;
 }
 
 int BmfrFilter::block_side(std::int64_t param, int w, int h) {
@@ -263,6 +264,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   phase1_.clear_guards();
   const Reprojection& rep = phase1_.last_reprojection();
   last_cut_ = rep.cut;
+  had_history_ = rep.has_history && !rep.cut;
   if (rep.cut) note("camera cut: " + std::to_string(rep.discarded) + " of " + std::to_string(n) + " pixels lost their history; restarted");
   if (!rep.has_history || rep.cut) {
     phase3_.reset();

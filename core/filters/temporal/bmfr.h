@@ -71,6 +71,9 @@ class BmfrFilter : public Filter {
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
   // run() reads the colour in phase I only and writes the whole roi at the end.
   bool run_in_place() const override { return true; }
+  // A frame with a usable history is a temporal estimate: only a still (or a sequence's
+  // first frame, or the one after a cut) steps back toward its input.
+  bool step_back_applies() const override { return !had_history_; }
 
  private:
   // Phase II (bmfr_fit.cpp).
@@ -92,6 +95,7 @@ class BmfrFilter : public Filter {
   int taa_w_ = 0, taa_h_ = 0;              // size of taa_hist_ (0: none)
   std::int64_t frame_index_ = 0;
   bool last_cut_ = false;
+  bool had_history_ = false;  // the last run() blended a usable history
   std::array<double, kStages> stage_ms_{};
   std::array<double, kStages> stage_cpu_ms_{};
 };
