@@ -119,8 +119,11 @@ Frame component_frame(const Frame& frame, const LightComponent& component, int n
       case Role::SecondPosition:
       case Role::SecondNormal:
       case Role::SampleCount:
-      case Role::Alpha: out.passes.push_back(p); break;
-      default: break;  // colour, variance (the beauty's), the light passes
+      case Role::Alpha:
+      // The colour passes describe the surface (prepare/surface_classes.h tells mirrors by them).
+      case Role::DiffuseColour:
+      case Role::GlossyColour: out.passes.push_back(p); break;
+      default: break;  // colour, variance (the beauty's), the other light passes
     }
   }
   // The component's colour pass is its albedo feature (edge-stopping, guides): noise-free, it

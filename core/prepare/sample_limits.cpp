@@ -5,14 +5,16 @@
 #include <limits>
 
 #include "image/luminance.h"
-#include "kernels/window_sums.h"
 #include "util/parallel.h"
 
 namespace mcr {
 
 namespace {
 
-// The window's sums without its centre, added pixel by pixel.
+constexpr float kY0 = 0.2126f, kY1 = 0.7152f, kY2 = 0.0722f;
+
+// The window's sums without its centre, added pixel by pixel in double (the few pixels
+// whose own value dwarfs their window's sums).
 void direct(const Image& rgb, int x, int y, int radius, double& s, double& s2, double& n) {
   s = s2 = n = 0;
   for (int qy = std::max(0, y - radius); qy <= std::min(rgb.height() - 1, y + radius); ++qy)
@@ -28,53 +30,92 @@ void direct(const Image& rgb, int x, int y, int radius, double& s, double& s2, d
 
 }  // namespace
 
+// Float planes, each window summed directly (a row pass of 2r+1 taps, then a column pass):
+// no running sums, so a firefly of 1e30 cannot leave its rounding behind in the pixels
+// after it. Float is enough for a bound: the variance's rounding (1e-6 of E[Y^2]) matters
+// only where sd < 0.01 mu / k, where the 0.01 |mu| floor decides anyway.
 void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit) {
   const int w = rgb.width(), h = rgb.height();
-  limit.resize(std::size_t(w) * std::size_t(h));
-  // Kept between frames by the calling thread (a sequence's frames are the same size).
-  // (References: a thread_local named inside the workers would be each worker's own.)
-  thread_local WindowSums kept_sum, kept_sq;
-  WindowSums& sum = kept_sum;
-  WindowSums& sq = kept_sq;
-  sum.reset(w, h, true);
-  sq.reset(w, h, false);
+  const std::size_t n = std::size_t(w) * std::size_t(h);
+  limit.resize(n);
+  // Kept by the calling thread between frames (references: a thread_local named inside
+  // the workers would be each worker's own). Planes: Y (0 where not finite), finite (1/0),
+  // and the row sums of Y, Y^2, finite.
+  thread_local std::vector<float> kept;
+  std::vector<float>& buf = kept;
+  buf.resize(5 * n);
+  float* ly = buf.data();
+  float* lf = ly + n;
+  float* rs = lf + n;
+  float* rq = rs + n;
+  float* rc = rq + n;
   parallel_rows(0, h, nthreads, [&](int y) {
+    const float* p = rgb.pixel(0, y);
+    const std::size_t rb = std::size_t(y) * std::size_t(w);
     for (int x = 0; x < w; ++x) {
-      const float* p = rgb.pixel(x, y);
-      if (!finite3(p)) continue;  // left at 0, counted 0
-      const double v = luminance(p);
-      sum.set(x, y, v, 1.0);
-      sq.set(x, y, v * v, 1.0);
+      const float* q = p + std::size_t(x) * 3;
+      const float v = kY0 * q[0] + kY1 * q[1] + kY2 * q[2];
+      const bool ok = v - v == 0.0f;
+      ly[rb + std::size_t(x)] = ok ? v : 0.0f;
+      lf[rb + std::size_t(x)] = ok ? 1.0f : 0.0f;
+    }
+    for (int x = 0; x < w; ++x) {
+      float s = 0, q = 0, c = 0;
+      for (int t = std::max(0, x - radius), e = std::min(w - 1, x + radius); t <= e; ++t) {
+        const float v = ly[rb + std::size_t(t)];
+        s += v;
+        q += v * v;
+        c += lf[rb + std::size_t(t)];
+      }
+      rs[rb + std::size_t(x)] = s;
+      rq[rb + std::size_t(x)] = q;
+      rc[rb + std::size_t(x)] = c;
     }
   });
-  sum.sum_windows(radius, nthreads);
-  sq.sum_windows(radius, nthreads);
-  constexpr double kMax = double(std::numeric_limits<float>::max());
+  const float kf = float(k);
+  constexpr float kMax = std::numeric_limits<float>::max(), kInfF = std::numeric_limits<float>::infinity();
   parallel_rows(0, h, nthreads, [&](int y) {
+    const std::size_t rb = std::size_t(y) * std::size_t(w);
+    const int y0 = std::max(0, y - radius), y1 = std::min(h - 1, y + radius);
+    float* out = limit.data() + rb;
+    // The window sums without the centre, and the bound, in float (vectorised) ...
     for (int x = 0; x < w; ++x) {
-      const float* p = rgb.pixel(x, y);
-      double s = sum.value(x, y), s2 = sq.value(x, y), n = sum.count(x, y);
-      if (finite3(p)) {  // the centre is not its own neighbour
-        const double v = luminance(p);
-        s -= v;
-        s2 -= v * v;
-        n -= 1.0;
+      float s = 0, q = 0, c = 0;
+      for (int t = y0; t <= y1; ++t) {
+        const std::size_t j = std::size_t(t) * std::size_t(w) + std::size_t(x);
+        s += rs[j];
+        q += rq[j];
+        c += rc[j];
       }
-      float& out = limit[std::size_t(y) * std::size_t(w) + std::size_t(x)];
-      // A centre that dominates its window (a firefly of 1e30 among 0.5s) would leave
-      // only rounding after the subtraction: those few pixels are summed directly.
-      if (finite3(p)) {
-        const double v = luminance(p);
-        if (std::fabs(v) * 1e-9 > std::fabs(s) || v * v * 1e-9 > std::fabs(s2)) direct(rgb, x, y, radius, s, s2, n);
+      const float v = ly[rb + std::size_t(x)], f = lf[rb + std::size_t(x)];
+      s -= v;
+      q -= v * v;
+      c -= f;
+      const float mu = s / std::max(c, 1.0f);
+      const float sd = std::sqrt(std::max(q / std::max(c, 1.0f) - mu * mu, 0.0f));
+      const float bound = mu + std::max(kf * sd, 0.01f * std::fabs(mu));
+      out[x] = c < 2.5f ? kInfF : std::min(bound, kMax);  // an overflowed bound reads as the largest float
+    }
+    // ... then, rarely, a centre that dwarfs its window (its removal leaves only rounding)
+    // or a Y^2 that overflowed: summed again pixel by pixel in double.
+    for (int x = 0; x < w; ++x) {
+      const float v = ly[rb + std::size_t(x)];
+      float s = 0, q = 0;
+      for (int t = y0; t <= y1; ++t) {
+        s += rs[std::size_t(t) * std::size_t(w) + std::size_t(x)];
+        q += rq[std::size_t(t) * std::size_t(w) + std::size_t(x)];
       }
-      if (n < 2.5) {
-        out = std::numeric_limits<float>::infinity();
+      if (!(std::fabs(v) * 1e-4f > std::fabs(s - v) || !(q <= kMax) || v * v * 1e-4f > q - v * v)) continue;
+      double ds, dq, dc;
+      direct(rgb, x, y, radius, ds, dq, dc);
+      if (dc < 2.5) {
+        out[x] = kInfF;
         continue;
       }
-      const double mu = s / n;
-      const double sd = std::sqrt(std::max(s2 / n - mu * mu, 0.0));
+      const double mu = ds / dc;
+      const double sd = std::sqrt(std::max(dq / dc - mu * mu, 0.0));
       const double bound = mu + std::max(k * sd, 0.01 * std::fabs(mu));
-      out = std::isfinite(bound) ? float(std::min(bound, kMax)) : float(kMax);
+      out[x] = std::isfinite(bound) ? float(std::min(bound, double(kMax))) : kMax;
     }
   });
 }

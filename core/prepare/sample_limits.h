@@ -9,8 +9,9 @@
 // outlier rule in prepare/outliers.h, so a firefly is cut to what its neighbours back,
 // and a highlight several pixels wide (its neighbours bright too) is left alone. The
 // accumulation (temporal/accumulation.h) lets a sample through above this when its own
-// history backs it. Sums in double from window sums (kernels/window_sums.h): the
-// variance as E[Y^2] - mu^2 loses only what a bound cannot notice (sd below 1e-8 mu).
+// history backs it. Float window sums, each window added directly (no running sums); a
+// centre that dwarfs its window is summed pixel by pixel in double: within 1e-3 of the
+// rule in double, plenty for a bound.
 #include <cstdint>
 #include <vector>
 

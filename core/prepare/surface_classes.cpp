@@ -34,19 +34,32 @@ void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out) {
   std::vector<std::size_t> light(std::size_t(std::max(h, 0)), 0), mirror(light.size(), 0);
   parallel_rows(0, h, nthreads, [&](int y) {
     std::uint8_t* f = out.flags.data() + std::size_t(y) * std::size_t(w);
-    for (int x = 0; x < w; ++x) {
-      if (albedo && max3(albedo->image, x, y) > 1.0f) {
-        f[x] |= SurfaceClasses::kLightInAlbedo;
-        ++light[std::size_t(y)];
+    std::size_t nl = 0, nm = 0;
+    if (albedo && albedo->image.channels() == 3) {  // the usual RGB albedo: a flat loop
+      const float* a = albedo->image.pixel(0, y);
+      for (int x = 0; x < w; ++x) {
+        const float* p = a + std::size_t(x) * 3;
+        const bool light = (p[0] > 1.0f) | (p[1] > 1.0f) | (p[2] > 1.0f);  // false for NaN
+        f[x] = light ? SurfaceClasses::kLightInAlbedo : 0;
+        nl += light;
       }
-      if (out.colour_passes) {
+    } else if (albedo) {
+      for (int x = 0; x < w; ++x)
+        if (max3(albedo->image, x, y) > 1.0f) {
+          f[x] |= SurfaceClasses::kLightInAlbedo;
+          ++nl;
+        }
+    }
+    if (out.colour_passes)
+      for (int x = 0; x < w; ++x) {
         const float d = max3(diffuse->image, x, y), g = max3(glossy->image, x, y);
         if (d >= 0.0f && g > kMirrorGloss && g > kMirrorRatio * d) {
           f[x] |= SurfaceClasses::kMirror;
-          ++mirror[std::size_t(y)];
+          ++nm;
         }
       }
-    }
+    light[std::size_t(y)] = nl;
+    mirror[std::size_t(y)] = nm;
   });
   out.light_in_albedo = out.mirror = 0;
   for (std::size_t i = 0; i < light.size(); ++i) {
