@@ -185,7 +185,9 @@ TEST(Components, ComponentFrameCarriesFeaturesItsColourAsAlbedoNotTheBeautysVari
   for (Role r : {Role::Normal, Role::Position, Role::Albedo, Role::Motion}) EXPECT_TRUE(g.has(r)) << role_name(r);
   EXPECT_EQ(g.image(Role::Albedo).storage(), f.image(Role::GlossyColour).storage());  // not Denoising Albedo
   EXPECT_FALSE(g.has(Role::Variance));
-  EXPECT_FALSE(g.has(Role::GlossyColour));
+  // The colour passes go along (bmfr tells mirrors by them); the other light passes do not.
+  EXPECT_TRUE(g.has(Role::GlossyColour) && g.has(Role::DiffuseColour));
+  EXPECT_FALSE(g.has(Role::GlossyDirect) || g.has(Role::DiffuseDirect) || g.has(Role::Emission));
 }
 
 TEST(Components, NothingNonFiniteLeavesTheRecombination) {
