@@ -9,8 +9,9 @@ AccumulationGuards HistoryGuards::build(const Image& signal, const SurfaceClasse
   AccumulationGuards g;
   g.history_factor = float(s.history_factor);
   if (s.limit_k > 0) {
-    firefly_limits(signal, s.limit_radius, s.limit_k, nthreads, limit_);
+    firefly_limits(signal, s.limit_radius, s.limit_k, nthreads, limit_, s.limit_k_fresh, &fresh_);
     g.limit = limit_.data();
+    g.limit_fresh = fresh_.data();
   }
   alpha_floor_.clear();
   if (classes.mirror && s.mirror_alpha > 0) {

@@ -34,10 +34,12 @@ void direct(const Image& rgb, int x, int y, int radius, double& s, double& s2, d
 // no running sums, so a firefly of 1e30 cannot leave its rounding behind in the pixels
 // after it. Float is enough for a bound: the variance's rounding (1e-6 of E[Y^2]) matters
 // only where sd < 0.01 mu / k, where the 0.01 |mu| floor decides anyway.
-void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit) {
+void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit, double k_fresh,
+                    std::vector<float>* fresh) {
   const int w = rgb.width(), h = rgb.height();
   const std::size_t n = std::size_t(w) * std::size_t(h);
   limit.resize(n);
+  if (fresh) fresh->resize(n);
   // Kept by the calling thread between frames (references: a thread_local named inside
   // the workers would be each worker's own). Planes: Y (0 where not finite), finite (1/0),
   // and the row sums of Y, Y^2, finite.
@@ -72,12 +74,13 @@ void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::v
       rc[rb + std::size_t(x)] = c;
     }
   });
-  const float kf = float(k);
+  const float kf = float(k), kff = float(k_fresh);
   constexpr float kMax = std::numeric_limits<float>::max(), kInfF = std::numeric_limits<float>::infinity();
   parallel_rows(0, h, nthreads, [&](int y) {
     const std::size_t rb = std::size_t(y) * std::size_t(w);
     const int y0 = std::max(0, y - radius), y1 = std::min(h - 1, y + radius);
     float* out = limit.data() + rb;
+    float* outf = fresh ? fresh->data() + rb : nullptr;
     // The window sums without the centre, and the bound, in float (vectorised) ...
     for (int x = 0; x < w; ++x) {
       float s = 0, q = 0, c = 0;
@@ -95,6 +98,7 @@ void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::v
       const float sd = std::sqrt(std::max(q / std::max(c, 1.0f) - mu * mu, 0.0f));
       const float bound = mu + std::max(kf * sd, 0.01f * std::fabs(mu));
       out[x] = c < 2.5f ? kInfF : std::min(bound, kMax);  // an overflowed bound reads as the largest float
+      if (outf) outf[x] = c < 2.5f ? kInfF : std::min(mu + std::max(kff * sd, 0.01f * std::fabs(mu)), kMax);
     }
     // ... then, rarely, a centre that dwarfs its window (its removal leaves only rounding)
     // or a Y^2 that overflowed: summed again pixel by pixel in double.
@@ -110,12 +114,17 @@ void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::v
       direct(rgb, x, y, radius, ds, dq, dc);
       if (dc < 2.5) {
         out[x] = kInfF;
+        if (outf) outf[x] = kInfF;
         continue;
       }
       const double mu = ds / dc;
       const double sd = std::sqrt(std::max(dq / dc - mu * mu, 0.0));
-      const double bound = mu + std::max(k * sd, 0.01 * std::fabs(mu));
-      out[x] = std::isfinite(bound) ? float(std::min(bound, double(kMax))) : kMax;
+      auto bound = [&](double kk) {
+        const double b = mu + std::max(kk * sd, 0.01 * std::fabs(mu));
+        return std::isfinite(b) ? float(std::min(b, double(kMax))) : kMax;
+      };
+      out[x] = bound(k);
+      if (outf) outf[x] = bound(k_fresh);
     }
   });
 }

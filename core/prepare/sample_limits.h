@@ -21,7 +21,9 @@ namespace mcr {
 
 // limit: one float per pixel of rgb (resized), +inf where the window has fewer than 3
 // finite neighbours, the largest float where the bound would overflow.
-void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit);
+// fresh (when given): the same with k_fresh, in the same pass.
+void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::vector<float>& limit, double k_fresh = 0,
+                    std::vector<float>* fresh = nullptr);
 
 // cap: per pixel of rgb (resized), the largest finite luminance of its 3x3 neighbourhood
 // (centre included) where flags[i] & mask, +inf elsewhere: how bright a history the

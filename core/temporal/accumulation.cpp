@@ -43,6 +43,7 @@ constexpr float kY0 = 0.2126f, kY1 = 0.7152f, kY2 = 0.0722f;
 void row3(int y, const Reprojection& r, const float* crow_all, const float* hist, const float* hcount, float af,
           int w, float* orow, float* ncount, const AccumulationGuards& g, int xb = 0) {
   const float* lim = g.limit ? g.limit + std::size_t(y) * std::size_t(w) : nullptr;
+  const float* limf = g.limit && g.limit_fresh ? g.limit_fresh + std::size_t(y) * std::size_t(w) : nullptr;
   const float* afl = g.alpha_floor ? g.alpha_floor + std::size_t(y) * std::size_t(w) : nullptr;
   const float* cap = g.history_cap ? g.history_cap + std::size_t(y) * std::size_t(w) : nullptr;
   const float hf = g.history_factor;
@@ -100,7 +101,8 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
     }
     if (lim && finite) {
       const float yh = have ? kY0 * h0 + kY1 * h1 + kY2 * h2 : 0.0f;
-      const float bound = std::max(std::max(lim[x], hf * yh), 0.0f);
+      const float l = (have || !limf) ? lim[x] : limf[x];
+      const float bound = std::max(std::max(l, hf * yh), 0.0f);
       const float yc = kY0 * c0 + kY1 * c1 + kY2 * c2;
       if (yc > bound) {
         const float sc = bound / yc;
@@ -141,6 +143,7 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
                                                const AccumulationGuards& g) {
   const std::size_t rb = std::size_t(y) * std::size_t(w);
   const float* lim = g.limit ? g.limit + rb : nullptr;
+  const float* limf = g.limit && g.limit_fresh ? g.limit_fresh + rb : nullptr;
   const float* afl = g.alpha_floor ? g.alpha_floor + rb : nullptr;
   const float* cap = g.history_cap ? g.history_cap + rb : nullptr;
   const __m256 hfv = _mm256_set1_ps(g.history_factor), ky0 = _mm256_set1_ps(kY0), ky1 = _mm256_set1_ps(kY1),
@@ -250,7 +253,9 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
     if (lim) {  // row3's guard: the same operations (std::max(a, b) = max_ps(b, a))
       const __m256 yh = _mm256_and_ps(
           have, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, h0), _mm256_mul_ps(ky1, h1)), _mm256_mul_ps(ky2, h2)));
-      const __m256 bound = _mm256_max_ps(zero, _mm256_max_ps(_mm256_mul_ps(hfv, yh), _mm256_loadu_ps(lim + x)));
+      const __m256 lv = _mm256_loadu_ps(lim + x);
+      const __m256 l = limf ? _mm256_blendv_ps(_mm256_loadu_ps(limf + x), lv, have) : lv;
+      const __m256 bound = _mm256_max_ps(zero, _mm256_max_ps(_mm256_mul_ps(hfv, yh), l));
       const __m256 yc = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, c0), _mm256_mul_ps(ky1, c1)), _mm256_mul_ps(ky2, c2));
       const __m256 cut = _mm256_and_ps(finite, _mm256_cmp_ps(yc, bound, _CMP_GT_OQ));
       const __m256 sc = _mm256_div_ps(bound, yc);

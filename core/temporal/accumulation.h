@@ -7,7 +7,8 @@
 // alpha, then by an exponential moving average of weight alpha.
 //
 // Guards (optional, per pixel, AccumulationGuards below) act on the new value before the
-// blend: its luminance is cut to max(limit, history_factor x the history's luminance, 0),
+// blend: its luminance is cut to max(limit, history_factor x the history's luminance, 0)
+// (limit_fresh instead of limit where the pixel has no history, when given),
 // RGB scaled alike (a firefly that neither its neighbours nor its own history back is cut
 // to what they do back; a highlight that persists is not), and its weight is at least
 // alpha_floor (a pixel whose history cannot be trusted, such as a mirror whose reflection
@@ -28,6 +29,7 @@ namespace mcr {
 
 struct AccumulationGuards {
   const float* limit = nullptr;        // w x h luminance bounds (prepare/sample_limits.h), or none
+  const float* limit_fresh = nullptr;  // w x h, for pixels without history (else `limit`), or none
   const float* alpha_floor = nullptr;  // w x h, or none
   const float* history_cap = nullptr;  // w x h luminance bounds of the history (+inf: none), or none
   float history_factor = 4.0f;

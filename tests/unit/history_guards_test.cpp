@@ -129,6 +129,12 @@ TEST(AccumulationGuards, AFireflyIsCutUnlessItsHistoryBacksIt) {
   Image second = first;
   const Image& b = acc.accumulate(second, s.position, s.normal, nullptr, 1);
   EXPECT_NEAR(b.at(3, 3, 0), 0.5f * (2.0f + 8.0f), 1e-5);
+  // A pixel without history takes limit_fresh when given.
+  std::vector<float> fresh(std::size_t(w) * h, 6.0f);
+  g.limit_fresh = fresh.data();
+  TemporalAccumulator acc2(AccumulationParams{0.2, {}});
+  acc2.set_guards(g);
+  EXPECT_NEAR(acc2.accumulate(first, s.position, s.normal, nullptr, 1).at(3, 3, 0), 6.0f, 1e-5);
   // A sample within 4x its history passes whole.
   Image third = flat(w, h, 0.5f);
   third.at(3, 3, 0) = third.at(3, 3, 1) = third.at(3, 3, 2) = 12.0f;  // history 5: bound 20
@@ -160,13 +166,14 @@ TEST(AccumulationGuards, EveryInstructionSetGivesTheSameBits) {
   StaticShot s(w, h);
   std::mt19937 rng(7);
   std::uniform_real_distribution<float> u(0.0f, 3.0f);
-  std::vector<float> lim(std::size_t(w) * h), afl(lim.size()), cap(lim.size());
+  std::vector<float> lim(std::size_t(w) * h), fresh(lim.size()), afl(lim.size()), cap(lim.size());
   for (std::size_t i = 0; i < lim.size(); ++i) {
     lim[i] = i % 5 == 0 ? kInf : u(rng);
+    fresh[i] = 2.0f * lim[i];
     afl[i] = i % 3 == 0 ? 0.7f : 0.0f;
     cap[i] = i % 4 == 0 ? u(rng) : kInf;
   }
-  AccumulationGuards g{lim.data(), afl.data(), cap.data(), 2.5f};
+  AccumulationGuards g{lim.data(), fresh.data(), afl.data(), cap.data(), 2.5f};
   std::vector<Image> outs;
   for (Isa level : {Isa::Generic, best_isa()}) {
     const ScopedIsa use(level);
