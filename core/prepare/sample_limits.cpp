@@ -132,21 +132,39 @@ void firefly_limits(const Image& rgb, int radius, double k, int nthreads, std::v
 void neighbourhood_caps(const Image& rgb, const std::vector<std::uint8_t>& flags, std::uint8_t mask, int nthreads,
                         std::vector<float>& cap) {
   const int w = rgb.width(), h = rgb.height();
-  cap.resize(std::size_t(w) * std::size_t(h));
+  const std::size_t n = std::size_t(w) * std::size_t(h);
+  cap.resize(n);
+  // Separable: the 3-wide row maxima of the finite luminance (-inf where none), then the
+  // 3-tall maxima of those, in float (a cap, not a sum).
+  thread_local std::vector<float> kept;
+  std::vector<float>& rowmax = kept;
+  rowmax.resize(n);
+  constexpr float kNone = -std::numeric_limits<float>::infinity();
   parallel_rows(0, h, nthreads, [&](int y) {
+    const float* p = rgb.pixel(0, y);
+    float* r = rowmax.data() + std::size_t(y) * std::size_t(w);
+    float prev = kNone, cur = kNone;
+    auto lum = [&](int x) {
+      const float* q = p + std::size_t(x) * 3;
+      const float v = kY0 * q[0] + kY1 * q[1] + kY2 * q[2];
+      return (v - v == 0.0f) ? v : kNone;
+    };
+    if (w > 0) cur = lum(0);
     for (int x = 0; x < w; ++x) {
-      const std::size_t i = std::size_t(y) * std::size_t(w) + std::size_t(x);
-      double m = std::numeric_limits<double>::infinity();
-      if (flags[i] & mask) {
-        m = -std::numeric_limits<double>::infinity();
-        for (int qy = std::max(0, y - 1); qy <= std::min(h - 1, y + 1); ++qy)
-          for (int qx = std::max(0, x - 1); qx <= std::min(w - 1, x + 1); ++qx) {
-            const float* q = rgb.pixel(qx, qy);
-            if (finite3(q)) m = std::max(m, luminance(q));
-          }
-        if (!(m > -std::numeric_limits<double>::infinity())) m = std::numeric_limits<double>::infinity();  // none finite
-      }
-      cap[i] = std::isinf(m) ? std::numeric_limits<float>::infinity() : float(std::min(m, double(std::numeric_limits<float>::max())));
+      const float next = x + 1 < w ? lum(x + 1) : kNone;
+      r[x] = std::max(std::max(prev, cur), next);
+      prev = cur;
+      cur = next;
+    }
+  });
+  parallel_rows(0, h, nthreads, [&](int y) {
+    const std::size_t rb = std::size_t(y) * std::size_t(w);
+    const float* up = rowmax.data() + std::size_t(std::max(0, y - 1)) * std::size_t(w);
+    const float* mid = rowmax.data() + rb;
+    const float* down = rowmax.data() + std::size_t(std::min(h - 1, y + 1)) * std::size_t(w);
+    for (int x = 0; x < w; ++x) {
+      const float m = std::max(std::max(up[x], mid[x]), down[x]);
+      cap[rb + std::size_t(x)] = (flags[rb + std::size_t(x)] & mask) && m > kNone ? m : std::numeric_limits<float>::infinity();
     }
   });
 }
