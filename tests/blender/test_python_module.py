@@ -222,11 +222,12 @@ def test_needs_match_info_and_settings(tmp):
 
 
 def test_notes_hold_unused_settings(tmp):
-    err = cli("denoise", ROOM, "-o", os.path.join(tmp, "n.exr"), "-f", "box", "--set", "firefly_radius=5",
-              "--verbose", stderr=True)
+    # firefly_k is on by default: off, firefly_radius is the unused setting.
+    err = cli("denoise", ROOM, "-o", os.path.join(tmp, "n.exr"), "-f", "box", "--set", "firefly_k=0",
+              "--set", "firefly_radius=5", "--verbose", stderr=True)
     notes = [l[len("mcrecon: note: "):] for l in err.splitlines() if l.startswith("mcrecon: note: ")]
     assert notes == ["firefly_radius has no effect with firefly_k=0"], err
-    s = mcrecon.Session("box", {"firefly_radius": 5})
+    s = mcrecon.Session("box", {"firefly_k": 0.0, "firefly_radius": 5})
     assert s.notes() == notes, s.notes()
     s.denoise_file(ROOM, os.path.join(tmp, "n_py.exr"))
     assert s.notes()[:1] == notes, s.notes()  # still first after a run

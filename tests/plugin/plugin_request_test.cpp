@@ -109,7 +109,8 @@ TEST(PluginRequest, CompressionIsCheckedOnTheOutputSide) {
 TEST(PluginRequest, NotesTextJoinsTheNotes) {
   EXPECT_EQ(notes_text({}), "");
   EXPECT_EQ(notes_text({"a has no effect", "b"}), "a has no effect; b");
-  Request r = make_request("r.exr", {{"filter", "box"}, {"firefly_radius", "5"}}, false);
+  // firefly_k is on by default: off, firefly_radius is an unused setting.
+  Request r = make_request("r.exr", {{"filter", "box"}, {"firefly_k", "0"}, {"firefly_radius", "5"}}, false);
   EXPECT_EQ(notes_text(make_reconstruction(r)->notes()), "firefly_radius has no effect with firefly_k=0");
 }
 

@@ -372,9 +372,10 @@ class TestNotes(PluginTestBase):
         return unused, [l[len(prefix):] for l in err.splitlines() if l.startswith(prefix)]
 
     def test_unused_setting_is_the_mcrecon_notes_attribute(self):
-        notes, run = self.cli_notes("-f", "box", "--set", "firefly_radius=5")
+        # firefly_k is on by default: off, firefly_radius is the unused setting.
+        notes, run = self.cli_notes("-f", "box", "--set", "firefly_k=0", "--set", "firefly_radius=5")
         self.assertEqual(notes, ["firefly_radius has no effect with firefly_k=0"])
-        name = ROOM + ".mcrecon?filter=box&firefly_radius=5"
+        name = ROOM + ".mcrecon?filter=box&firefly_k=0&firefly_radius=5"
         # 1. the input plugin's spec, before any pixel is read
         oiio.attribute("plugin_searchpath", plugin_dir())
         inp = oiio.ImageInput.open(name)
@@ -390,8 +391,8 @@ class TestNotes(PluginTestBase):
         self.assertEqual(header_attribute(read, "mcreconNotes"), notes[0])
         # 3. the output plugin's file: the unused setting first, then the run's notes
         out = self.path("out.exr")
-        check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "--attrib:type=int", "mcrecon:firefly_radius",
-                          "5", "-o:fileformatname=mcrecon", out))
+        check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "box", "--attrib:type=float", "mcrecon:firefly_k", "0",
+                          "--attrib:type=int", "mcrecon:firefly_radius", "5", "-o:fileformatname=mcrecon", out))
         self.assertEqual(header_attribute(out, "mcreconNotes"), "; ".join(notes + run))
         # Without the setting only the run's notes are said.
         quiet_notes, quiet_run = self.cli_notes("-f", "box")

@@ -82,8 +82,12 @@ TEST(FilterNeeds, SettingsWithoutEffectAreReported) {
       if (n.find(what) != std::string::npos) return true;
     return false;
   };
-  EXPECT_TRUE(mentions(unused("box", {{"firefly_radius", "5"}}), "firefly_radius has no effect with firefly_k=0"));
+  // firefly_k is on by default in the image filters, off in bmfr (its sample limit does that job).
+  EXPECT_TRUE(unused("box", {{"firefly_radius", "5"}}).empty());
+  EXPECT_TRUE(mentions(unused("box", {{"firefly_radius", "5"}, {"firefly_k", "0"}}),
+                       "firefly_radius has no effect with firefly_k=0"));
   EXPECT_TRUE(unused("box", {{"firefly_radius", "5"}, {"firefly_k", "2"}}).empty());
+  EXPECT_TRUE(mentions(unused("bmfr", {{"firefly_radius", "5"}}), "firefly_radius has no effect with firefly_k=0"));
   EXPECT_TRUE(mentions(unused("box", {{"albedo_prefilter_position", "0.1"}}), "albedo_prefilter_position"));
   EXPECT_TRUE(unused("box", {{"albedo_prefilter_position", "0.1"}, {"albedo_prefilter", "0.2"}}).empty());
   EXPECT_TRUE(mentions(unused("box", {{"albedo_floor", "0.05"}}), "albedo_floor has no effect with demodulate=false"));

@@ -195,7 +195,8 @@ TEST(PwafVarianceTest, VariancePassIsUsedWhenPresent) {
       for (int c = 0; c < 3; ++c) im.at(x, y, c) = 0.1f;
   Frame f = frame_of(im);
   f.passes.push_back(named_pass(Role::Variance, "variance", Image(32, 8, 1, 1e-8f)));
-  const PwafRun tight = run_pwaf(f, {{"adaptive", false}, {"demodulate", false}});
+  // firefly_k=0: no outlier step, whose count would be one more note.
+  const PwafRun tight = run_pwaf(f, {{"adaptive", false}, {"demodulate", false}, {"firefly_k", 0.0}});
   EXPECT_TRUE(tight.stats.variance_from_pass);
   EXPECT_TRUE(tight.notes.size() == 3u) << "only the dropped weights are noted";
   EXPECT_NEAR(tight.out.at(15, 4, 0), 0.0f, 1e-4);
@@ -316,14 +317,15 @@ TEST(PwafOutlierTest, FilterOutputNearAFireflyStaysAtTheBackground) {
       for (int x = 14; x <= 26; ++x) m = std::max(m, r.out.at(x, y, 0));
     return m;
   };
-  const PwafRun both = run_pwaf(f);
+  // firefly_k=0 throughout: pwaf's own mechanisms, without the common outlier step.
+  const PwafRun both = run_pwaf(f, {{"firefly_k", 0.0}});
   EXPECT_LE(worst(both), 0.6f);
   EXPECT_EQ(both.stats.outliers_replaced, 1u);
-  const PwafRun replacement_only = run_pwaf(f, {{"prefilter_sigma", 0.0}});
+  const PwafRun replacement_only = run_pwaf(f, {{"prefilter_sigma", 0.0}, {"firefly_k", 0.0}});
   EXPECT_LE(worst(replacement_only), 0.6f);
-  const PwafRun range_only = run_pwaf(f, {{"outlier_k", 0.0}});
+  const PwafRun range_only = run_pwaf(f, {{"outlier_k", 0.0}, {"firefly_k", 0.0}});
   EXPECT_LT(worst(range_only), 1.0f);
-  const PwafRun neither = run_pwaf(f, {{"outlier_k", 0.0}, {"prefilter_sigma", 0.0}});
+  const PwafRun neither = run_pwaf(f, {{"outlier_k", 0.0}, {"prefilter_sigma", 0.0}, {"firefly_k", 0.0}});
   EXPECT_GT(worst(neither), 1.0f);
 }
 
@@ -423,7 +425,8 @@ TEST(PwafNotesTest, NamesTheDroppedWeightsWhenSecondHitPassesAreAbsent) {
 TEST(PwafNotesTest, NoNoteWhenEveryPassIsPresent) {
   Frame every = full_frame(16, 12, 33, /*second=*/true, /*variance=*/true);
   every.passes.push_back(named_pass(Role::Albedo, "albedo", random_image(16, 12, 34, 0.1f, 1.0f)));
-  const PwafRun r = run_pwaf(every);
+  // firefly_k=0: no outlier step, whose count is a note of its own (not about a pass).
+  const PwafRun r = run_pwaf(every, {{"firefly_k", 0.0}});
   EXPECT_TRUE(r.notes.empty()) << r.notes.front();
   // Without the variance pass only the estimate is noted, no weight is named.
   const PwafRun e = run_pwaf(full_frame(16, 12, 33, true, false));
