@@ -184,6 +184,7 @@ void add_array(mcr::Frame& frame, Role role, const py::object& obj, mcr::Space s
 struct ArrayPasses {
   py::object colour, albedo, normal, position, depth, motion, variance, sample_count, alpha;
   std::string normal_space;
+  py::object diffuse_colour = py::none(), glossy_colour = py::none();  // Blender's DiffCol / GlossCol (mirrors)
 };
 
 mcr::Space space_from(const std::string& s, const char* what) {
@@ -206,6 +207,8 @@ mcr::Frame frame_from_arrays(const ArrayPasses& a) {
   add_array(f, Role::Variance, a.variance, mcr::Space::None);
   add_array(f, Role::SampleCount, a.sample_count, mcr::Space::None);
   add_array(f, Role::Alpha, a.alpha, mcr::Space::None);
+  add_array(f, Role::DiffuseColour, a.diffuse_colour, mcr::Space::None);
+  add_array(f, Role::GlossyColour, a.glossy_colour, mcr::Space::None);
   f.check_sizes();
   return f;
 }
@@ -434,15 +437,18 @@ PYBIND11_MODULE(mcrecon, m) {
           "denoise",
           [](Session& s, py::object colour, py::object albedo, py::object normal, py::object position, py::object depth,
              py::object motion, py::object variance, py::object sample_count, py::object alpha,
-             const std::string& normal_space, const py::object& roi) {
-            return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
+             const std::string& normal_space, const py::object& roi, py::object diffuse_colour, py::object glossy_colour) {
+            return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space,
+                              diffuse_colour, glossy_colour},
                              roi);
           },
           py::arg("colour"), py::arg("albedo") = py::none(), py::arg("normal") = py::none(),
           py::arg("position") = py::none(), py::arg("depth") = py::none(), py::arg("motion") = py::none(),
           py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
-          py::arg("normal_space") = "world", py::arg("roi") = py::none(),
-          "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32.")
+          py::arg("normal_space") = "world", py::arg("roi") = py::none(), py::arg("diffuse_colour") = py::none(),
+          py::arg("glossy_colour") = py::none(),
+          "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32. diffuse_colour / "
+          "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them).")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
            "Reads a render (multilayer EXR), filters it and writes output (temp + rename); returns stage timings "
@@ -456,17 +462,20 @@ PYBIND11_MODULE(mcrecon, m) {
       [](const std::string& filter, py::object colour, py::object albedo, py::object normal, py::object position,
          py::object depth, py::object motion, py::object variance, py::object sample_count, py::object alpha,
          const std::string& normal_space, const py::dict& params, int threads, const py::object& roi,
-         const py::object& accumulate) {
+         const py::object& accumulate, py::object diffuse_colour, py::object glossy_colour) {
         Session s(filter, params, threads, accumulate);
-        return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space},
+        return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space,
+                          diffuse_colour, glossy_colour},
                          roi);
       },
       py::arg("filter"), py::arg("colour"), py::arg("albedo") = py::none(), py::arg("normal") = py::none(),
       py::arg("position") = py::none(), py::arg("depth") = py::none(), py::arg("motion") = py::none(),
       py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
       py::arg("normal_space") = "world", py::arg("params") = py::dict(), py::arg("threads") = 0,
-      py::arg("roi") = py::none(), py::arg("accumulate") = false,
-      "Filters one frame given as float32 H x W x C numpy arrays (colour RGB or RGBA, features as available); "
+      py::arg("roi") = py::none(), py::arg("accumulate") = false, py::arg("diffuse_colour") = py::none(),
+      py::arg("glossy_colour") = py::none(),
+      "Filters one frame given as float32 H x W x C numpy arrays (colour RGB or RGBA, features as available; "
+      "diffuse_colour / glossy_colour: Blender's Diffuse / Glossy Color, by which bmfr and accumulate tell mirrors); "
       "returns H x W x 3 float32.");
 
   m.def(

@@ -108,7 +108,8 @@ Image Reconstruction::run_stage(Stage& stage, Frame& frame, const ExecOptions& o
   stage.accumulator.clear_guards();
   if (stage.classes.mirror)
     notes_.push_back("accumulation: " + std::to_string(stage.classes.mirror) +
-                     " mirror-like pixels (Glossy Color > 10x Diffuse Color) keep no history");
+                     " mirror-like pixels (Glossy Color > 10x Diffuse Color) keep a half-weight history, no brighter "
+                     "than their 3x3 neighbourhood");
   const std::size_t ch = std::size_t(colour.channels());
   for (std::size_t i = 0; i < acc.pixel_count(); ++i)
     for (std::size_t c = 0; c < 3; ++c) colour.data()[i * ch + c] = acc.data()[i * 3 + c];

