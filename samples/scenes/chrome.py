@@ -64,22 +64,6 @@ def tiles(name, tile=0.1):
     return mat
 
 
-def glass(name, ior=1.5):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    g = nt.nodes.new("ShaderNodeBsdfGlass")
-    g.distribution = "GGX"
-    g.inputs["Color"].default_value = (0.95, 0.98, 0.97, 1.0)
-    g.inputs["Roughness"].default_value = 0.0
-    g.inputs["IOR"].default_value = ior
-    nt.links.new(g.outputs["BSDF"], out.inputs["Surface"])
-    return mat
-
-
 def bevel(obj, width, segments=5):
     """Rounded edges with smooth normals across the bevel and sharp flat faces."""
     mod = obj.modifiers.new("Bevel", "BEVEL")
@@ -161,7 +145,7 @@ def build_props():
               (0.22, 0.018, 0.004), dark, rotation=(0, 0, math.radians(-12)))
 
     # Glass tumbler (front right) and a red ceramic mug with a handle (front left).
-    C.cylinder("tumbler", (0.72, 0.16, z0 + 0.055), 0.038, 0.11, glass("clear_glass"))
+    C.cylinder("tumbler", (0.72, 0.16, z0 + 0.055), 0.038, 0.11, C.glass("clear_glass", color=(0.95, 0.98, 0.97)))
     mug = C.principled("red_glaze", (0.55, 0.06, 0.05), roughness=0.15)
     C.cylinder("mug", (-0.12, 0.12, z0 + 0.045), 0.04, 0.09, mug)
     C.torus("mug_handle", (-0.12 + 0.045, 0.12, z0 + 0.05), 0.025, 0.007, mug,

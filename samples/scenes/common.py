@@ -228,6 +228,24 @@ def glossy_bsdf(name, color, roughness=0.1):
     return mat
 
 
+def glass(name, ior=1.5, color=None):
+    """Clear GGX Glass BSDF, roughness 0 (color None: the node's default white)."""
+    mat = bpy.data.materials.new(name)
+    mat.use_nodes = True
+    nt = mat.node_tree
+    for n in list(nt.nodes):
+        nt.nodes.remove(n)
+    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    g = nt.nodes.new("ShaderNodeBsdfGlass")
+    g.distribution = "GGX"
+    if color is not None:
+        g.inputs["Color"].default_value = (*color, 1.0)
+    g.inputs["Roughness"].default_value = 0.0
+    g.inputs["IOR"].default_value = ior
+    nt.links.new(g.outputs["BSDF"], out.inputs["Surface"])
+    return mat
+
+
 def emitter(name, color=(1.0, 1.0, 1.0), strength=10.0):
     """Pure emission material (for window-like emitters)."""
     mat = bpy.data.materials.new(name)

@@ -34,22 +34,6 @@ ORBIT_RADIUS, ORBIT_HEIGHT = 3.6, 1.25
 ORBIT_START_DEG, ORBIT_STEP_DEG = -22.5, 3.0  # azimuth of the camera around TARGET, per frame
 
 
-def glass(name, ior=1.45):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    g = nt.nodes.new("ShaderNodeBsdfGlass")
-    g.distribution = "GGX"
-    g.inputs["Color"].default_value = (0.92, 0.97, 1.0, 1.0)
-    g.inputs["Roughness"].default_value = 0.0
-    g.inputs["IOR"].default_value = ior
-    nt.links.new(g.outputs["BSDF"], out.inputs["Surface"])
-    return mat
-
-
 def linear_keys(obj):
     for fc in obj.animation_data.action.fcurves:
         fc.extrapolation = "LINEAR"
@@ -87,7 +71,7 @@ def build():
     C.torus("steel_torus", (1.15, 1.1, 0.36), 0.34, 0.12,
             C.principled("brushed_steel", (0.63, 0.64, 0.67), roughness=0.25, metallic=1.0),
             rotation=(math.radians(65), 0, math.radians(-25)))
-    C.sphere("glass_ball", (-0.75, -0.35, 0.2), 0.2, glass("clear_glass"))
+    C.sphere("glass_ball", (-0.75, -0.35, 0.2), 0.2, C.glass("clear_glass", ior=1.45, color=(0.92, 0.97, 1.0)))
     C.box("clay_cube", (-1.35, 1.3, 0.3), (0.6, 0.6, 0.6),
           C.noise_color("clay_noise", (0.20, 0.35, 0.55), (0.80, 0.70, 0.45), scale=4.0,
                         roughness=0.6), rotation=(0, 0, math.radians(30)))

@@ -90,21 +90,6 @@ def walnut(name):
     return mat
 
 
-def glass(name, ior=1.5):
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    g = nt.nodes.new("ShaderNodeBsdfGlass")
-    g.distribution = "GGX"
-    g.inputs["Roughness"].default_value = 0.0
-    g.inputs["IOR"].default_value = ior
-    nt.links.new(g.outputs["BSDF"], out.inputs["Surface"])
-    return mat
-
-
 def build():
     scene = C.reset_scene()
     # Sun 38 degrees up, from the left and a little behind the objects (as seen from the
@@ -129,8 +114,8 @@ def build():
                brushed_metal("brushed_steel", (0.75, 0.75, 0.77)))
     C.box("walnut_plinth", (0.55, 0.6, 0.25), (0.9, 0.7, 0.5), walnut("walnut"),
           rotation=(0, 0, math.radians(12)))
-    C.sphere("glass_sphere", (0.55, 0.6, 0.85), 0.35, glass("clear_glass"))
-    C.sphere("glass_ball_floor", (-0.1, -0.3, 0.3), 0.3, glass("clear_glass_2"))
+    C.sphere("glass_sphere", (0.55, 0.6, 0.85), 0.35, C.glass("clear_glass"))
+    C.sphere("glass_ball_floor", (-0.1, -0.3, 0.3), 0.3, C.glass("clear_glass_2"))
 
     C.camera("camera", (0.3, -4.2, 1.6), (0.1, 1.0, 0.45), lens=35.0)
     return scene
