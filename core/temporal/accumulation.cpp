@@ -40,6 +40,17 @@ namespace {
 // Rec. 709 luminance weights in float (the guards' luminance; image/luminance.h in double).
 constexpr float kY0 = 0.2126f, kY1 = 0.7152f, kY2 = 0.0722f;
 
+// RGB scaled alike so that its luminance is at most bound (the guards' cut).
+inline void cut_to(float bound, float& r, float& g, float& b) {
+  const float yl = kY0 * r + kY1 * g + kY2 * b;
+  if (yl > bound) {
+    const float sc = bound / yl;
+    r *= sc;
+    g *= sc;
+    b *= sc;
+  }
+}
+
 void row3(int y, const Reprojection& r, const float* crow_all, const float* hist, const float* hcount, float af,
           int w, float* orow, float* ncount, const AccumulationGuards& g, int xb = 0) {
   const float* lim = g.limit ? g.limit + std::size_t(y) * std::size_t(w) : nullptr;
@@ -89,27 +100,11 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
         have = true;
       }
     }
-    if (cap && have) {  // no brighter than the current neighbourhood
-      const float bound = std::max(cap[x], 0.0f);
-      const float yh = kY0 * h0 + kY1 * h1 + kY2 * h2;
-      if (yh > bound) {
-        const float sc = bound / yh;
-        h0 *= sc;
-        h1 *= sc;
-        h2 *= sc;
-      }
-    }
+    if (cap && have) cut_to(std::max(cap[x], 0.0f), h0, h1, h2);  // no brighter than the current neighbourhood
     if (lim && finite) {
       const float yh = have ? kY0 * h0 + kY1 * h1 + kY2 * h2 : 0.0f;
       const float l = (have || !limf) ? lim[x] : limf[x];
-      const float bound = std::max(std::max(l, hf * yh), 0.0f);
-      const float yc = kY0 * c0 + kY1 * c1 + kY2 * c2;
-      if (yc > bound) {
-        const float sc = bound / yc;
-        c0 *= sc;
-        c1 *= sc;
-        c2 *= sc;
-      }
+      cut_to(std::max(std::max(l, hf * yh), 0.0f), c0, c1, c2);
     }
     if (!finite) {
       o[0] = have ? h0 : 0.0f;  // invalid without history: value 0, count 0
