@@ -15,10 +15,7 @@ AccumulationGuards HistoryGuards::build(const Image& signal, const SurfaceClasse
   }
   alpha_floor_.clear();
   if (classes.mirror && s.mirror_alpha > 0) {
-    const std::size_t n = classes.flags.size();
-    alpha_floor_.resize(n);
-    for (std::size_t i = 0; i < n; ++i)
-      alpha_floor_[i] = (classes.flags[i] & SurfaceClasses::kMirror) ? float(s.mirror_alpha) : 0.0f;
+    class_values(classes, SurfaceClasses::kMirror, float(s.mirror_alpha), alpha_floor_);
     g.alpha_floor = alpha_floor_.data();
     neighbourhood_caps(signal, classes.flags, SurfaceClasses::kMirror, nthreads, cap_);
     g.history_cap = cap_.data();

@@ -32,8 +32,6 @@ class HistoryGuards {
   // into this object: valid until the next build().
   AccumulationGuards build(const Image& signal, const SurfaceClasses& classes, const HistoryGuardSettings& s,
                            int nthreads);
-  // Per pixel mirror_alpha on mirrors, else 0 (valid after a build() that found mirrors).
-  const float* alpha_floor() const { return alpha_floor_.empty() ? nullptr : alpha_floor_.data(); }
 
  private:
   std::vector<float> limit_, fresh_, alpha_floor_, cap_;

@@ -68,4 +68,9 @@ void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out) {
   }
 }
 
+void class_values(const SurfaceClasses& classes, std::uint8_t mask, float value, std::vector<float>& out) {
+  out.resize(classes.flags.size());
+  for (std::size_t i = 0; i < out.size(); ++i) out[i] = (classes.flags[i] & mask) ? value : 0.0f;
+}
+
 }  // namespace mcr

@@ -34,4 +34,7 @@ struct SurfaceClasses {
 // Flags of every pixel of `frame` (a non-finite value never sets a flag).
 void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out);
 
+// out[i] = value where flags[i] & mask, else 0 (a per-pixel weight floor for one class).
+void class_values(const SurfaceClasses& classes, std::uint8_t mask, float value, std::vector<float>& out);
+
 }  // namespace mcr

@@ -133,6 +133,21 @@ void row3(int y, const Reprojection& r, const float* crow_all, const float* hist
 // row3 for 8 pixels at a time (AVX2 without FMA: every lane does the float operations of
 // row3 in the same order, so the results are the same bit for bit). The taps are
 // gathered; a tap that row3 skips leaves the sums untouched (blend, not + 0).
+// cut_to for 8 pixels, where `on`: the same float operations in the same order.
+__attribute__((target("avx2"), always_inline)) inline __m256 luminance8(__m256 r, __m256 g, __m256 b) {
+  return _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(_mm256_set1_ps(kY0), r), _mm256_mul_ps(_mm256_set1_ps(kY1), g)),
+                       _mm256_mul_ps(_mm256_set1_ps(kY2), b));
+}
+__attribute__((target("avx2"), always_inline)) inline void cut_to8(__m256 bound, __m256 on, __m256& r, __m256& g,
+                                                                    __m256& b) {
+  const __m256 yl = luminance8(r, g, b);
+  const __m256 cut = _mm256_and_ps(on, _mm256_cmp_ps(yl, bound, _CMP_GT_OQ));
+  const __m256 sc = _mm256_div_ps(bound, yl);
+  r = _mm256_blendv_ps(r, _mm256_mul_ps(r, sc), cut);
+  g = _mm256_blendv_ps(g, _mm256_mul_ps(g, sc), cut);
+  b = _mm256_blendv_ps(b, _mm256_mul_ps(b, sc), cut);
+}
+
 __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, const float* crow_all, const float* hist,
                                                const float* hcount, float af, int w, float* orow, float* ncount,
                                                const AccumulationGuards& g) {
@@ -141,8 +156,7 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
   const float* limf = g.limit && g.limit_fresh ? g.limit_fresh + rb : nullptr;
   const float* afl = g.alpha_floor ? g.alpha_floor + rb : nullptr;
   const float* cap = g.history_cap ? g.history_cap + rb : nullptr;
-  const __m256 hfv = _mm256_set1_ps(g.history_factor), ky0 = _mm256_set1_ps(kY0), ky1 = _mm256_set1_ps(kY1),
-               ky2 = _mm256_set1_ps(kY2);
+  const __m256 hfv = _mm256_set1_ps(g.history_factor);
   const float* crow = crow_all + rb * 3;
   const std::uint8_t* taps = r.taps.data() + rb;
   const float* pxs = r.prev_x.data() + rb;
@@ -235,28 +249,12 @@ __attribute__((target("avx2"))) void row3_avx2(int y, const Reprojection& r, con
       const __m256 rc = _mm256_cvtepi32_ps(_mm256_cvttps_epi32(_mm256_add_ps(_mm256_mul_ps(cnt, inv), half)));
       n = _mm256_and_ps(have, _mm256_max_ps(rc, one));
     }
-    if (cap) {  // row3's history cap, the same operations
-      const __m256 bound = _mm256_max_ps(zero, _mm256_loadu_ps(cap + x));
-      const __m256 resp = have;
-      const __m256 yh = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, h0), _mm256_mul_ps(ky1, h1)), _mm256_mul_ps(ky2, h2));
-      const __m256 cut = _mm256_and_ps(resp, _mm256_cmp_ps(yh, bound, _CMP_GT_OQ));
-      const __m256 sc = _mm256_div_ps(bound, yh);
-      h0 = _mm256_blendv_ps(h0, _mm256_mul_ps(h0, sc), cut);
-      h1 = _mm256_blendv_ps(h1, _mm256_mul_ps(h1, sc), cut);
-      h2 = _mm256_blendv_ps(h2, _mm256_mul_ps(h2, sc), cut);
-    }
+    if (cap) cut_to8(_mm256_max_ps(zero, _mm256_loadu_ps(cap + x)), have, h0, h1, h2);  // row3's history cap
     if (lim) {  // row3's guard: the same operations (std::max(a, b) = max_ps(b, a))
-      const __m256 yh = _mm256_and_ps(
-          have, _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, h0), _mm256_mul_ps(ky1, h1)), _mm256_mul_ps(ky2, h2)));
+      const __m256 yh = _mm256_and_ps(have, luminance8(h0, h1, h2));
       const __m256 lv = _mm256_loadu_ps(lim + x);
       const __m256 l = limf ? _mm256_blendv_ps(_mm256_loadu_ps(limf + x), lv, have) : lv;
-      const __m256 bound = _mm256_max_ps(zero, _mm256_max_ps(_mm256_mul_ps(hfv, yh), l));
-      const __m256 yc = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(ky0, c0), _mm256_mul_ps(ky1, c1)), _mm256_mul_ps(ky2, c2));
-      const __m256 cut = _mm256_and_ps(finite, _mm256_cmp_ps(yc, bound, _CMP_GT_OQ));
-      const __m256 sc = _mm256_div_ps(bound, yc);
-      c0 = _mm256_blendv_ps(c0, _mm256_mul_ps(c0, sc), cut);
-      c1 = _mm256_blendv_ps(c1, _mm256_mul_ps(c1, sc), cut);
-      c2 = _mm256_blendv_ps(c2, _mm256_mul_ps(c2, sc), cut);
+      cut_to8(_mm256_max_ps(zero, _mm256_max_ps(_mm256_mul_ps(hfv, yh), l)), finite, c0, c1, c2);
     }
     // Finite with history: blend; finite without: the new value (count 1); non-finite:
     // the history (or 0, count 0).

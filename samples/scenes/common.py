@@ -211,39 +211,33 @@ def principled(name, color=(0.8, 0.8, 0.8), roughness=0.5, metallic=0.0, specula
     return mat
 
 
-def glossy_bsdf(name, color, roughness=0.1):
-    """Plain Glossy BSDF (GGX). Unlike the Principled BSDF, whose GlossCol pass is always 1.0 in
-    Blender 3.4, its colour shows up in the GlossCol pass."""
+def single_bsdf(name, node_type, inputs):
+    """A material of one GGX BSDF node (node_type) into the output; inputs: {socket: value}."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nt = mat.node_tree
     for n in list(nt.nodes):
         nt.nodes.remove(n)
     out = nt.nodes.new("ShaderNodeOutputMaterial")
-    gl = nt.nodes.new("ShaderNodeBsdfGlossy")
-    gl.distribution = "GGX"
-    gl.inputs["Color"].default_value = (*color, 1.0)
-    gl.inputs["Roughness"].default_value = roughness
-    nt.links.new(gl.outputs["BSDF"], out.inputs["Surface"])
+    node = nt.nodes.new(node_type)
+    node.distribution = "GGX"
+    for socket, value in inputs.items():
+        node.inputs[socket].default_value = value
+    nt.links.new(node.outputs["BSDF"], out.inputs["Surface"])
     return mat
+
+
+def glossy_bsdf(name, color, roughness=0.1):
+    """Plain Glossy BSDF (GGX). Unlike the Principled BSDF, whose GlossCol pass is always 1.0 in
+    Blender 3.4, its colour shows up in the GlossCol pass."""
+    return single_bsdf(name, "ShaderNodeBsdfGlossy", {"Color": (*color, 1.0), "Roughness": roughness})
 
 
 def glass(name, ior=1.5, color=None):
     """Clear GGX Glass BSDF, roughness 0 (color None: the node's default white)."""
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
-    g = nt.nodes.new("ShaderNodeBsdfGlass")
-    g.distribution = "GGX"
-    if color is not None:
-        g.inputs["Color"].default_value = (*color, 1.0)
-    g.inputs["Roughness"].default_value = 0.0
-    g.inputs["IOR"].default_value = ior
-    nt.links.new(g.outputs["BSDF"], out.inputs["Surface"])
-    return mat
+    inputs = {} if color is None else {"Color": (*color, 1.0)}
+    inputs.update({"Roughness": 0.0, "IOR": ior})
+    return single_bsdf(name, "ShaderNodeBsdfGlass", inputs)
 
 
 def emitter(name, color=(1.0, 1.0, 1.0), strength=10.0):

@@ -6,18 +6,12 @@
 #include <cmath>
 
 #include "filters/registry.h"
+#include "pass_testutil.h"
 
 namespace mcr {
 namespace {
 
-Pass pass_of(Role role, const std::string& name, Image im, Space space = Space::None) {
-  Pass p;
-  p.role = role;
-  p.name = name;
-  p.space = space;
-  p.image = std::move(im);
-  return p;
-}
+using testutil::make_pass;
 
 // A flat floor seen by a static camera (every pixel its own history).
 Frame floor_frame(const Image& colour, const Image& albedo, bool colour_passes, float diffuse) {
@@ -34,14 +28,14 @@ Frame floor_frame(const Image& colour, const Image& albedo, bool colour_passes, 
   f.width = w;
   f.height = h;
   f.path = "synthetic.exr";
-  f.passes.push_back(pass_of(Role::Colour, "Combined", colour));
-  f.passes.push_back(pass_of(Role::Position, "Position", pos, Space::World));
-  f.passes.push_back(pass_of(Role::Normal, "Normal", nrm, Space::World));
-  f.passes.push_back(pass_of(Role::Albedo, "Denoising Albedo", albedo));
-  f.passes.push_back(pass_of(Role::Motion, "Vector", Image(w, h, 4)));
+  f.passes.push_back(make_pass(Role::Colour, "Combined", colour));
+  f.passes.push_back(make_pass(Role::Position, "Position", pos, Space::World));
+  f.passes.push_back(make_pass(Role::Normal, "Normal", nrm, Space::World));
+  f.passes.push_back(make_pass(Role::Albedo, "Denoising Albedo", albedo));
+  f.passes.push_back(make_pass(Role::Motion, "Vector", Image(w, h, 4)));
   if (colour_passes) {
-    f.passes.push_back(pass_of(Role::DiffuseColour, "DiffCol", Image(w, h, 3, diffuse)));
-    f.passes.push_back(pass_of(Role::GlossyColour, "GlossCol", Image(w, h, 3, 1.0f)));
+    f.passes.push_back(make_pass(Role::DiffuseColour, "DiffCol", Image(w, h, 3, diffuse)));
+    f.passes.push_back(make_pass(Role::GlossyColour, "GlossCol", Image(w, h, 3, 1.0f)));
   }
   return f;
 }

@@ -11,22 +11,16 @@
 #include <random>
 
 #include "filters/registry.h"
+#include "pass_testutil.h"
 #include "util/error.h"
 
 namespace mcr {
 namespace {
 
+using testutil::make_pass;
+
 constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
-
-Pass make_pass(Role role, const std::string& name, Image im, Space space = Space::None) {
-  Pass p;
-  p.role = role;
-  p.name = name;
-  p.space = space;
-  p.image = std::move(im);
-  return p;
-}
 
 // A curved surface seen by a static camera: positions, normals, and a colour that is
 // exactly  0.4 + 0.2 n_x + 0.3 w_x - 0.1 w_y + 0.25 w_z^2  (per channel scaled).

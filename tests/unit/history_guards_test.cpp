@@ -8,6 +8,7 @@
 #include <random>
 
 #include "image/luminance.h"
+#include "pass_testutil.h"
 #include "prepare/history_guards.h"
 #include "prepare/sample_limits.h"
 #include "prepare/surface_classes.h"
@@ -191,14 +192,6 @@ TEST(AccumulationGuards, EveryInstructionSetGivesTheSameBits) {
   for (std::size_t i = 0; i < outs[0].storage().size(); ++i) ASSERT_EQ(outs[0].storage()[i], outs[1].storage()[i]) << i;
 }
 
-Pass pass_of(Role role, Image im) {
-  Pass p;
-  p.role = role;
-  p.name = role_name(role);
-  p.image = std::move(im);
-  return p;
-}
-
 TEST(SurfaceClasses, LightInTheAlbedoAndMirrorsFromTheColourPasses) {
   Frame f;
   f.width = 4;
@@ -207,13 +200,14 @@ TEST(SurfaceClasses, LightInTheAlbedoAndMirrorsFromTheColourPasses) {
   albedo.at(0, 0, 1) = 200.0f;                                      // holds light
   for (int c = 0; c < 3; ++c) diffuse.at(1, 0, c) = 0.0f;           // a metal
   for (int c = 0; c < 3; ++c) diffuse.at(2, 0, c) = 0.05f;          // gloss 20x diffuse: mirror-like
-  f.passes = {pass_of(Role::Colour, Image(4, 1, 3, 1.0f)), pass_of(Role::Albedo, albedo)};
+  f.passes = {testutil::make_pass(Role::Colour, "Combined", Image(4, 1, 3, 1.0f)),
+              testutil::make_pass(Role::Albedo, "Denoising Albedo", albedo)};
   SurfaceClasses sc;
   classify_surfaces(f, 1, sc);
   EXPECT_FALSE(sc.colour_passes);
   EXPECT_EQ(sc.flags, (std::vector<std::uint8_t>{1, 0, 0, 0}));
-  f.passes.push_back(pass_of(Role::DiffuseColour, diffuse));
-  f.passes.push_back(pass_of(Role::GlossyColour, glossy));
+  f.passes.push_back(testutil::make_pass(Role::DiffuseColour, "DiffCol", diffuse));
+  f.passes.push_back(testutil::make_pass(Role::GlossyColour, "GlossCol", glossy));
   classify_surfaces(f, 1, sc);
   EXPECT_TRUE(sc.colour_passes);
   EXPECT_EQ(sc.flags, (std::vector<std::uint8_t>{1, 2, 2, 0}));

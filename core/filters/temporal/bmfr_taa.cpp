@@ -438,9 +438,7 @@ void BmfrFilter::taa(const Reprojection& rep, bool hist, const Roi& roi, Image& 
     s.ycocg = params_.get_enum("taa_clip") == "ycocg_variance";
     s.gamma = float(params_.get_float("taa_gamma"));
     if (classes_.mirror) {  // mirrors: the blend weight at least mirror_taa_alpha
-      const float a = float(params_.get_float("mirror_taa_alpha"));
-      taa_alpha_.resize(n);
-      for (std::size_t i = 0; i < n; ++i) taa_alpha_[i] = (classes_.flags[i] & SurfaceClasses::kMirror) ? a : 0.0f;
+      class_values(classes_, SurfaceClasses::kMirror, float(params_.get_float("mirror_taa_alpha")), taa_alpha_);
       s.alpha_floor = taa_alpha_.data();
     }
     taa_next_.resize(3 * n);
