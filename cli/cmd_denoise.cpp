@@ -24,6 +24,8 @@ struct DenoiseArgs {
   bool keep_passes = false, keep_components = false, timings = false, verbose = false, resume = false;
   bool accumulate = false;  // the accumulation stage before the filter
   int threads = 0;
+  DisplayTransform display;  // PNG/JPEG/TIFF outputs
+  int bits = 0;
 };
 
 Roi parse_region(const std::string& text) {
@@ -61,6 +63,8 @@ int run_denoise(const DenoiseArgs& a) {
   wo.keep_passes = a.keep_passes;
   wo.keep_components = a.keep_components;
   wo.compression = checked_exr_compression(a.compression);
+  wo.display = a.display;
+  wo.bits = a.bits;
   ExecOptions eo;
   eo.nthreads = a.threads;
   if (!a.region.empty()) eo.roi = parse_region(a.region);
@@ -109,7 +113,7 @@ int run_denoise(const DenoiseArgs& a) {
   for (const auto& j : jobs) outputs.push_back(j.second);
   if (seq) check_sequence_outputs(a.output, parse_frame_range(a.frames), inputs);  // every frame its own file
   else check_output_paths(outputs, inputs);
-  check_exr_name(a.output);  // after the guard: a device or an input is the graver fault to name
+  check_write(a.output, wo);  // after the guard: a device or an input is the graver fault to name
 
   const bool temporal = session.reconstruction().temporal();
   // Settings that change nothing: said once, not per frame.
@@ -165,7 +169,10 @@ int run_denoise(const DenoiseArgs& a) {
 Run add_denoise(CLI::App& app) {
   auto a = std::make_shared<DenoiseArgs>();
   app.add_option("input", a->input, "render or sequence pattern (shot_####.exr, shot_%04d.exr)")->required();
-  app.add_option("-o,--output", a->output, "output EXR (a pattern for sequences)")->required();
+  app.add_option("-o,--output", a->output,
+                 "output file (a pattern for sequences): .exr (scene-linear float) or .png, .jpg, .tif "
+                 "(display-referred through --view)")
+      ->required();
   app.add_option("-f,--filter", a->filter,
                  "filter name (see `mcrecon filters`); auto scores every filter the passes allow on sample tiles "
                  "and runs the best, or keeps the input (--verbose names its choice and the scores)")
@@ -184,6 +191,17 @@ Run add_denoise(CLI::App& app) {
   app.add_flag("--keep-components", a->keep_components,
                "with --set components=light_passes: write each denoised light component as its own float layer "
                "(<layer>.Denoised.Diffuse, Glossy, Transmission, Emission, Environment), summing to R,G,B exactly");
+  app.add_option("--view", a->display.view,
+                 "PNG/JPEG/TIFF output: the OpenColorIO view (Blender's: Standard, Filmic, Filmic Log, Raw, False Color)")
+      ->capture_default_str();
+  app.add_option("--look", a->display.look, "PNG/JPEG/TIFF output: an OpenColorIO look (e.g. 'Medium High Contrast')");
+  app.add_option("--display", a->display.display, "PNG/JPEG/TIFF output: the OpenColorIO display")->capture_default_str();
+  app.add_option("--exposure", a->display.exposure, "PNG/JPEG/TIFF output: exposure in stops before the view")
+      ->capture_default_str();
+  app.add_option("--gamma", a->display.gamma, "PNG/JPEG/TIFF output: display gamma after the view")->capture_default_str();
+  app.add_option("--ocio-config", a->display.config, "OpenColorIO config for the view (default: Blender's)")
+      ->capture_default_str();
+  app.add_option("--bit-depth", a->bits, "PNG/TIFF output: 8 or 16 bits per channel (default: PNG 8, TIFF 16; JPEG is 8)");
   app.add_flag("--resume", a->resume, "skip frames whose output exists (temporal filters replay them without writing)");
   app.add_flag("--accumulate", a->accumulate,
                "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");

@@ -128,6 +128,50 @@ std::vector<mcr::PassOverride> overrides_from_dict(const py::dict& passes) {
   return out;
 }
 
+// display= of the file functions: None, or a dict of the view a PNG/JPEG/TIFF output goes
+// through ({'view': 'Filmic', 'look': ..., 'display': 'sRGB', 'exposure': 0.0, 'gamma': 1.0,
+// 'config': path, 'bit_depth': 8 or 16}); an unknown key or a value of the wrong type is an
+// error naming it and what was given.
+mcr::WriteOptions write_options(bool keep_passes, bool keep_components, const py::object& display) {
+  mcr::WriteOptions wo;
+  wo.keep_passes = keep_passes;
+  wo.keep_components = keep_components;  // each denoised light component as a layer (components=light_passes)
+  if (display.is_none()) return wo;
+  if (!py::isinstance<py::dict>(display))
+    throw mcr::Error(Errc::InvalidArgument, "display expects a dict such as {'view': 'Filmic'}, got " +
+                                                py::repr(display).cast<std::string>());
+  auto bad = [](const std::string& key, const char* what, const py::handle& v) {
+    return mcr::Error(Errc::InvalidArgument, "display['" + key + "'] expects " + what + ", got " +
+                                                 py::repr(v).cast<std::string>());
+  };
+  for (const auto& item : py::reinterpret_borrow<py::dict>(display)) {
+    const std::string key = py::str(item.first).cast<std::string>();
+    const py::handle v = item.second;
+    std::string* text = key == "view"      ? &wo.display.view
+                        : key == "look"    ? &wo.display.look
+                        : key == "display" ? &wo.display.display
+                        : key == "config"  ? &wo.display.config
+                                           : nullptr;
+    if (text) {
+      if (!py::isinstance<py::str>(v)) throw bad(key, "a string", v);
+      *text = v.cast<std::string>();
+    } else if (key == "exposure" || key == "gamma") {
+      if (py::isinstance<py::bool_>(v) || !(py::isinstance<py::float_>(v) || py::isinstance<py::int_>(v)))
+        throw bad(key, "a number", v);
+      (key == "exposure" ? wo.display.exposure : wo.display.gamma) = v.cast<double>();
+    } else if (key == "bit_depth") {
+      if (py::isinstance<py::bool_>(v) || !py::isinstance<py::int_>(v)) throw bad(key, "8 or 16", v);
+      const long long b = v.cast<long long>();
+      if (b != 8 && b != 16) throw bad(key, "8 or 16", v);
+      wo.bits = int(b);
+    } else {
+      throw mcr::Error(Errc::InvalidArgument, "display: unknown key '" + key +
+                                                  "' (view, look, display, exposure, gamma, config, bit_depth)");
+    }
+  }
+  return wo;
+}
+
 mcr::ReadOptions read_options(const std::optional<std::string>& layer, const py::dict& passes) {
   mcr::ReadOptions ro;
   if (layer) ro.layer = *layer;
@@ -341,11 +385,10 @@ class Session {
   }
 
   py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,
-                        const py::dict& passes, bool keep_passes, bool keep_components = false) {
+                        const py::dict& passes, bool keep_passes, bool keep_components = false,
+                        const py::object& display = py::none()) {
     const mcr::ReadOptions ro = read_options(layer, passes);
-    mcr::WriteOptions wo;
-    wo.keep_passes = keep_passes;
-    wo.keep_components = keep_components;  // each denoised light component as a layer (components=light_passes)
+    const mcr::WriteOptions wo = write_options(keep_passes, keep_components, display);
     mcr::ReadOptions r = ro;
     r.keep_extra = keep_passes;
     const mcr::ExecOptions eo = exec_options(threads_, py::none());
@@ -451,7 +494,10 @@ PYBIND11_MODULE(mcrecon, m) {
           "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them).")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
-           "Reads a render (multilayer EXR), filters it and writes output (temp + rename); returns stage timings "
+           py::arg("display") = py::none(),
+           "Reads a render (multilayer EXR), filters it and writes output (temp + rename) in the format its "
+           "extension names (.exr; .png, .jpg, .tif through the OpenColorIO view in display=, e.g. "
+           "{'view': 'Filmic', 'exposure': 0.5}); returns stage timings "
            "and the notes (as notes()). "
            "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}. keep_components=True "
            "(with params components='light_passes'): each denoised light component as its own layer, as "
@@ -482,15 +528,18 @@ PYBIND11_MODULE(mcrecon, m) {
       "denoise_file",
       [](const std::string& input, const std::string& output, const std::string& filter, const py::dict& params,
          const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads,
-         const py::object& accumulate, bool keep_components) {
+         const py::object& accumulate, bool keep_components, const py::object& display) {
         Session s(filter, params, threads, accumulate);
-        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components);
+        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components, display);
       },
       py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
       py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
       py::arg("threads") = 0, py::arg("accumulate") = false, py::arg("keep_components") = false,
+      py::arg("display") = py::none(),
       "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate; "
-      "keep_components=True: --keep-components, with params={'components': 'light_passes'}); returns "
+      "keep_components=True: --keep-components, with params={'components': 'light_passes'}; display={'view': "
+      "'Filmic', 'look': ..., 'exposure': ..., 'gamma': ..., 'bit_depth': 8 or 16}: --view etc. for a "
+      ".png/.jpg/.tif output); returns "
       "stage timings and the notes `--verbose` prints (filter='auto': the scores and the filter chosen).");
 
   m.def(
@@ -499,7 +548,7 @@ PYBIND11_MODULE(mcrecon, m) {
          const std::string& filter,
          const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
          const std::optional<std::function<void(std::int64_t, std::int64_t, std::string)>>& progress, const py::object& accumulate,
-         bool keep_components) {
+         bool keep_components, const py::object& display) {
         const int first = int_from_py("first", first_arg), last = int_from_py("last", last_arg);
         for (const std::string* p : {&input, &output})
           if (!mcr::is_sequence_pattern(*p))
@@ -522,7 +571,7 @@ PYBIND11_MODULE(mcrecon, m) {
         py::list outputs;
         for (std::int64_t f = first; f <= last; ++f) {
           const std::string out = mcr::sequence_path(output, int(f));
-          s.denoise_file(inputs[std::size_t(f - first)], out, layer, passes, false, keep_components);
+          s.denoise_file(inputs[std::size_t(f - first)], out, layer, passes, false, keep_components, display);
           outputs.append(out);
           if (progress) (*progress)(f - first + 1, std::int64_t(last) - first + 1, out);
         }
@@ -531,7 +580,7 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("input"), py::arg("output"), py::arg("first"), py::arg("last"), py::arg("filter"),
       py::arg("params") = py::dict(), py::arg("layer") = py::none(), py::arg("passes") = py::dict(),
       py::arg("threads") = 0, py::arg("progress") = py::none(), py::arg("accumulate") = false,
-      py::arg("keep_components") = false,
+      py::arg("keep_components") = false, py::arg("display") = py::none(),
       "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history; "
       "accumulate=True as --accumulate); progress(done, total, output) is called after each frame. Returns the "
       "outputs written.");

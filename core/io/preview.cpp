@@ -1,10 +1,7 @@
 #include "io/preview.h"
 
-#include <OpenImageIO/color.h>
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
-
-#include <filesystem>
 
 #include "io/atomic_write.h"
 #include "util/error.h"
@@ -31,14 +28,7 @@ void write_side_by_side_png(const std::string& path, const std::vector<const Ima
     ImageBufAlgo::paste(strip, x, 0, 0, 0, tile, ROI(0, t->width(), 0, t->height(), 0, 1, 0, 3));
     x += t->width() + options.gap;
   }
-  std::error_code ec;
-  if (!std::filesystem::exists(options.config, ec))
-    throw Error(Errc::FileNotFound, "OpenColorIO config '" + options.config + "' not found (is blender installed?)");
-  ColorConfig config(options.config);
-  if (config.has_error()) throw Error(Errc::InvalidArgument, "OpenColorIO config '" + options.config + "': " + config.geterror());
-  ImageBuf display = ImageBufAlgo::ociodisplay(strip, options.display, options.view, options.from, "", false, "", "", &config);
-  if (display.has_error())
-    throw Error(Errc::InvalidArgument, "display transform " + options.display + "/" + options.view + " failed: " + display.geterror());
+  ImageBuf display = to_display(strip, options);
   display.set_write_format(TypeUInt8);
   write_atomic(display, path, "png", TypeUInt8);
 }

@@ -5,15 +5,12 @@
 #include <vector>
 
 #include "image/image.h"
+#include "io/display_transform.h"
 
 namespace mcr {
 
-struct DisplayOptions {
-  std::string config = "/usr/share/blender/datafiles/colormanagement/config.ocio";
-  std::string display = "sRGB";
-  std::string view = "Standard";
-  std::string from = "Linear";  // scene-linear space of the renders in that config
-  int gap = 4;                  // pixels between tiles
+struct DisplayOptions : DisplayTransform {
+  int gap = 4;  // pixels between tiles
 };
 
 // Writes tiles left to right (all the same height) as an 8-bit PNG via temp + rename.

@@ -40,8 +40,7 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     std::vector<std::string> inputs = loose_pass_files(read);
     inputs.push_back(input);
     check_output_path(output, inputs);
-    check_exr_name(output);  // Python and the add-on too: never EXR data under another name
-    checked_exr_compression(write.compression);
+    check_write(output, write);  // Python and the add-on too: what the name says, or an error
   }
   StageTimes t;
   auto t0 = std::chrono::steady_clock::now();

@@ -9,6 +9,7 @@
   changes with the settings; Session.notes() holds the unused setting `--verbose` prints;
 - filter "auto" is listed; denoise_file returns its notes (what it chose, as `--verbose` prints) and
   its output is the chosen filter's bit for bit;
+- denoise_file(display={...}) writes PNG/TIFF/JPEG as `mcrecon denoise --view ...` does;
 - errors raise mcrecon.Error naming the parameter / filter / pass, with .kind.
 Environment: MCRECON_BIN, MCRECON_SOURCE_DIR, MCRECON_PYTHON_DIR (the module's folder).
 """
@@ -290,6 +291,32 @@ def test_gil_released_while_filtering():
     print("GIL released while filtering: another Python thread ran during mcrecon.denoise")
 
 
+def test_display_outputs_match_cli(tmp):
+    """denoise_file(display=...) writes what `mcrecon denoise --view ...` writes, bit for bit."""
+    for name, args, display in (("s.png", [], None), ("f.tif", ["--view", "Filmic", "--exposure", "0.5"],
+                                                        {"view": "Filmic", "exposure": 0.5}),
+                                ("g.jpg", ["--gamma", "1.2"], {"gamma": 1.2})):
+        mine, theirs = os.path.join(tmp, "py_" + name), os.path.join(tmp, "cli_" + name)
+        mcrecon.denoise_file(ROOM, mine, "box", display=display)
+        cli("denoise", ROOM, "-o", theirs, "-f", "box", *args)
+        a, b = oiio.ImageBuf(mine), oiio.ImageBuf(theirs)
+        assert a.spec().format == b.spec().format and a.nchannels == b.nchannels, name
+        assert np.array_equal(a.get_pixels(oiio.FLOAT), b.get_pixels(oiio.FLOAT)), f"{name}: module and CLI differ"
+    out = os.path.join(tmp, "o.png")
+    expect_error(lambda: mcrecon.denoise_file(ROOM, out, "box", display={"view": "Filmc"}), "invalid_argument",
+                 "view 'Filmc'", "Filmic")
+    expect_error(lambda: mcrecon.denoise_file(ROOM, out, "box", display={"veiw": "Filmic"}), "invalid_argument",
+                 "'veiw'")
+    expect_error(lambda: mcrecon.denoise_file(ROOM, out, "box", display={"exposure": "high"}), "invalid_argument",
+                 "exposure", "'high'")
+    expect_error(lambda: mcrecon.denoise_file(ROOM, out, "box", display={"bit_depth": 12}), "invalid_argument",
+                 "bit_depth", "12")
+    expect_error(lambda: mcrecon.denoise_file(ROOM, out, "box", display="Filmic"), "invalid_argument", "'Filmic'")
+    expect_error(lambda: mcrecon.denoise_file(ROOM, out, "box", keep_passes=True), "invalid_argument", "keep_passes")
+    assert not os.path.exists(out)
+    print("display outputs: PNG/TIFF/JPEG as the CLI writes them; bad display settings raise mcrecon.Error")
+
+
 def test_errors(tmp):
     c = np.zeros((8, 8, 3), np.float32)
     expect_error(lambda: mcrecon.denoise("no_such_filter", c), "unknown_filter", "no_such_filter")
@@ -325,5 +352,6 @@ if __name__ == "__main__":
         test_notes_hold_unused_settings(tmp)
         test_two_threads_filter_at_once()
         test_gil_released_while_filtering()
+        test_display_outputs_match_cli(tmp)
         test_errors(tmp)
     print("OK")

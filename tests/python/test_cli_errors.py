@@ -368,17 +368,67 @@ class CliErrorTest(_TempDirCase):
             proc = self.assert_user_error(self.denoise(self.ml, "--compression", c), ["compression '%s'" % c])
             self.assertIn("none, rle, zip, zips, piz, pxr24, b44, b44a, dwaa, dwab", proc.stderr)
 
-    def test_output_must_be_an_exr_name(self):
-        for name in ("out.xyz", "out.png", "out", "out.exr.bak"):
+    def test_output_must_name_a_format_mcrecon_writes(self):
+        for name in ("out.xyz", "out.bmp", "out", "out.exr.bak"):
             out = os.path.join(self.out, name)
             self.assert_user_error(self.denoise(self.ml, out=out),
-                                   ["output '%s': mcrecon writes OpenEXR; use a .exr name" % out])
+                                   ["output '%s'" % out, "not a format mcrecon writes", ".exr", ".png"])
         pattern = os.path.join(self.seq_dir, "shot_####.exr")
-        out = os.path.join(self.out, "o_####.tif")
+        out = os.path.join(self.out, "o_####.gif")
         self.assert_user_error(["denoise", pattern, "--frames", "1-2", "-o", out, "-f", "box"],
-                               ["output '%s'" % out, "use a .exr name"])
-        out = os.path.join(self.out, "sparse.xyz")
+                               ["output '%s'" % out, "'.gif'"])
+        out = os.path.join(self.out, "sparse.png")  # sparse samples are data: EXR only
         self.assert_user_error(["sparsify", self.ml, "-o", out], ["output '%s'" % out, "use a .exr name"])
+
+    def test_display_output_settings_are_checked_before_filtering(self):
+        png = os.path.join(self.out, "out.png")
+        self.assert_user_error(self.denoise(self.ml, "--view", "Filmc", out=png),
+                               ["view 'Filmc'", "Standard, Filmic, Filmic Log, Raw, False Color"])
+        self.assert_user_error(self.denoise(self.ml, "--look", "Punchy", out=png), ["look 'Punchy'"])
+        self.assert_user_error(self.denoise(self.ml, "--keep-passes", out=png), ["PNG", "--keep-passes", ".exr"])
+        self.assert_user_error(self.denoise(self.ml, "--bit-depth", "16", out=os.path.join(self.out, "o.jpg")),
+                               ["bit depth 16", "JPEG takes 8"])
+        self.assert_user_error(self.denoise(self.ml, "--bit-depth", "12", out=png), ["bit depth 12", "8 or 16"])
+        self.assert_user_error(self.denoise(self.ml, "--ocio-config", "/nowhere/c.ocio", out=png), ["/nowhere/c.ocio"])
+
+    def test_png_jpeg_tiff_are_the_view_of_the_exr_result(self):
+        # A render with coverage (opaque, half, none) and smooth colour up to 2 (JPEG is lossy).
+        a = np.repeat(np.array([1.0, 0.5, 0.0, 1.0])[None, :], 16, 0).repeat(8, 1)[:, :, None]
+        y, x = np.mgrid[0:16, 0:32] / 31.0
+        colour = np.stack([2 * x, x * y + 0.1, 0.5 * (1 - y)], 2)
+        src = os.path.join(self.out, "cov.exr")
+        tu.write_exr(src, np.concatenate([colour * a, a], 2), ["R", "G", "B", "A"])
+        exr = os.path.join(self.out, "o.exr")
+        self.assertEqual(self.run_cli(*self.denoise(src, "--set", "radius=0", out=exr)).returncode, 0)
+        rgba = tu.read_channels(exr, ["R", "G", "B", "A"]).astype(np.float64)
+
+        def srgb(linear):  # IEC 61966-2-1
+            v = np.clip(linear, 0, 1)
+            return np.where(v <= 0.0031308, 12.92 * v, 1.055 * v ** (1 / 2.4) - 0.055)
+        # PNG and TIFF keep straight alpha (the view of colour / alpha); JPEG, without alpha, the
+        # image over black.
+        straight = srgb(rgba[..., :3] / np.maximum(rgba[..., 3:], 1e-30))
+        for name, depth, tol in (("o.png", 8, 0.5), ("o.tif", 16, 14.0), ("o.jpg", 8, 3.0)):
+            out = os.path.join(self.out, name)
+            proc = self.run_cli(*self.denoise(src, "--set", "radius=0", out=out))
+            self.assertEqual(proc.returncode, 0, proc.stderr)
+            want = srgb(rgba[..., :3]) if name.endswith("jpg") else straight
+            config = oiio.ImageSpec()
+            config.attribute("oiio:UnassociatedAlpha", 1)
+            inp = oiio.ImageInput.open(out, config)
+            spec = inp.spec()
+            self.assertEqual(spec.format, "uint%d" % depth, name)
+            self.assertEqual(spec.nchannels, 3 if name.endswith("jpg") else 4, name)
+            codes = inp.read_image(0, 0, 0, 3, "float").astype(np.float64) * (2 ** depth - 1)
+            inp.close()
+            diff = np.abs(codes - want * (2 ** depth - 1))
+            err = diff.mean() if name.endswith("jpg") else diff.max()  # JPEG: lossy, on average
+            self.assertLessEqual(err, tol, "%s: %.2f codes off the sRGB transfer of the EXR result" % (name, err))
+        filmic = os.path.join(self.out, "filmic.png")
+        self.assertEqual(self.run_cli(*self.denoise(src, "--view", "Filmic", out=filmic)).returncode, 0)
+        standard = oiio.ImageBuf(os.path.join(self.out, "o.png")).get_pixels(oiio.FLOAT)
+        self.assertFalse(np.array_equal(standard, oiio.ImageBuf(filmic).get_pixels(oiio.FLOAT)))
+        self.assertEqual(sorted(f for f in os.listdir(self.out) if TEMP_MARK in f), [])
 
     def test_demo_spp_level_the_samples_lack(self):
         samples = os.path.join(tu.source_dir(), "samples", "data")

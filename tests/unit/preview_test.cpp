@@ -14,18 +14,14 @@
 
 #include "expect_error.h"
 #include "scratch_dir.h"
+#include "srgb_testutil.h"
 
 namespace mcr {
 namespace {
 
 using namespace testutil;
 
-// IEC 61966-2-1 sRGB encoding of a linear value in [0, 1], and its inverse.
-double srgb_encode(double v) { return v <= 0.0031308 ? 12.92 * v : 1.055 * std::pow(v, 1 / 2.4) - 0.055; }
-double srgb_decode(double e) { return e <= 0.04045 ? e / 12.92 : std::pow((e + 0.055) / 1.055, 2.4); }
-
-// The 8-bit code of a linear value: clamp to [0, 1], encode, round.
-int expected_code(double linear) { return int(std::lround(255.0 * srgb_encode(std::clamp(linear, 0.0, 1.0)))); }
+int expected_code(double linear) { return srgb_code(linear); }
 
 struct Png {
   int width = 0, height = 0, channels = 0;
