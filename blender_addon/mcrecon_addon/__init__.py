@@ -15,7 +15,7 @@ bl_info = {
     "category": "Render",
 }
 
-from . import native, properties, passes, render_hooks, operators, ui  # noqa: E402
+from . import native, properties, passes, render_hooks, operators, ui, changes  # noqa: E402
 
 _modules = (properties, operators, ui, render_hooks)
 
@@ -27,5 +27,13 @@ def register():
 
 
 def unregister():
+    # Disabling the add-on puts back every scene setting it changed (changes.py).
+    import bpy
+    try:
+        scenes = list(bpy.data.scenes)
+    except AttributeError:  # restricted data (Blender starting or quitting): nothing to restore
+        scenes = []
+    for scene in scenes:
+        changes.restore(scene)
     for m in reversed(_modules):
         m.unregister()

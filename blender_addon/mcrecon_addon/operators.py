@@ -4,7 +4,7 @@ import os
 
 import bpy
 
-from . import native, pass_output, properties
+from . import changes, native, pass_output, properties
 
 
 _ITEMS = []  # Blender needs the strings of dynamic enum items kept alive
@@ -102,6 +102,18 @@ class MCRECON_OT_apply_passes(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class MCRECON_OT_restore_scene(bpy.types.Operator):
+    """Put back every scene setting mcrecon changed (passes, Cycles denoising, compositing) and remove the nodes it added"""
+    bl_idname = "mcrecon.restore_scene"
+    bl_label = "Restore Scene Settings"
+    bl_options = {"REGISTER", "UNDO"}
+
+    def execute(self, context):
+        n = changes.restore(context.scene, log=lambda m: self.report({"INFO"}, m))
+        self.report({"INFO"}, f"mcrecon: {n} change(s) put back")
+        return {"FINISHED"}
+
+
 class MCRECON_OT_report(bpy.types.Operator):
     """Turns a message from a render handler into a Blender report (Info editor, status bar)."""
     bl_idname = "mcrecon.report"
@@ -116,7 +128,7 @@ class MCRECON_OT_report(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_report)
+_classes = (MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
 
 
 def register():

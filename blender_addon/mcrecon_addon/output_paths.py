@@ -12,19 +12,28 @@ def frame_path(pattern, frame):
     return pattern
 
 
-def output_for_frame(output_path, frame, animation):
+# The extensions mcrecon writes (io/output_format.h): EXR, or PNG/JPEG/TIFF through the view.
+EXTENSIONS = (".exr", ".png", ".jpg", ".jpeg", ".tif", ".tiff")
+
+
+def has_known_extension(path):
+    return os.path.splitext(path)[1].lower() in EXTENSIONS
+
+
+def output_for_frame(output_path, frame, animation, default_ext=".exr"):
     """The denoised file of one frame for the add-on's Output setting (an absolute path).
 
     '#' runs take the frame number. Without '#', an animation (more than one frame written)
     gets the frame number, 4 digits, before the extension as Blender numbers its own output
-    (out.exr -> out0001.exr), so frames never overwrite each other. '.exr' is added when missing."""
+    (out.exr -> out0001.exr), so frames never overwrite each other. default_ext (the render's
+    format: '.png' for a PNG render) is added when the name has no extension mcrecon writes."""
     if "#" in output_path:
         out = frame_path(output_path, frame)
     elif animation:
         stem, ext = os.path.splitext(output_path)
-        if ext.lower() != ".exr":
+        if ext.lower() not in EXTENSIONS:
             stem, ext = output_path, ""
         out = stem + str(frame).zfill(4) + ext
     else:
         out = output_path
-    return out if out.lower().endswith(".exr") else out + ".exr"
+    return out if has_known_extension(out) else out + default_ext

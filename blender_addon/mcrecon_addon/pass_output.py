@@ -1,11 +1,15 @@
 """When the render's own output is not OpenEXR MultiLayer (PNG, JPEG, plain EXR, or F12 with no
 file at all), the add-on writes the passes itself: a compositor File Output node named
 "mcrecon passes" writes a multilayer EXR per frame into Blender's temp folder, with the same
-channel names a multilayer render has ("ViewLayer.Combined.R", ..., "Composite.Combined.R")."""
+channel names a multilayer render has ("ViewLayer.Combined.R", ..., "Composite.Combined.R"); the
+render hooks delete each file once it is denoised. The node and the compositing switches are
+changes recorded in changes.py."""
 import os
 import threading
 
 import bpy
+
+from . import changes
 
 NODE = "mcrecon passes"
 
@@ -41,10 +45,13 @@ def ensure(scene, log=print):
         if n is not None:
             scene.node_tree.nodes.remove(n)
         return None
-    if not scene.use_nodes:
-        scene.use_nodes = True  # creates Render Layers -> Composite: the image is unchanged
-        log("mcrecon: turned on compositing nodes to write the passes (the output format is not MultiLayer)")
-    scene.render.use_compositing = True
+    why = "to write the passes: the output format is not OpenEXR MultiLayer"
+    # use_nodes creates Render Layers -> Composite (the image is unchanged): nodes the add-on added.
+    had = {n.name for n in scene.node_tree.nodes} if scene.node_tree is not None else set()
+    if changes.set_value(scene, "", "use_nodes", True, why, log):
+        for name in sorted({n.name for n in scene.node_tree.nodes} - had):
+            changes.added_node(scene, name, "created with the compositing nodes", log)
+    changes.set_value(scene, "render", "use_compositing", True, why, log)
     tree = scene.node_tree
     vl = view_layer(scene)
     rl = next((x for x in tree.nodes if x.bl_idname == "CompositorNodeRLayers" and x.layer == vl.name), None)
@@ -52,10 +59,12 @@ def ensure(scene, log=print):
         rl = tree.nodes.new("CompositorNodeRLayers")
         rl.layer = vl.name
         rl.location = (-300, -400)
+        changes.added_node(scene, rl.name, why, log)
     if n is None:
         n = tree.nodes.new("CompositorNodeOutputFile")
         n.name = n.label = NODE
         n.location = (300, -400)
+        changes.added_node(scene, NODE, why, log)
     n.format.file_format = "OPEN_EXR_MULTILAYER"
     n.format.color_depth = "32"
     n.format.exr_codec = "ZIP"

@@ -26,6 +26,8 @@ LIGHT_TOGGLES = {
     "emission": ("", "use_pass_emit"),
     "environment": ("", "use_pass_environment"),
 }
+from . import changes  # noqa: E402
+
 # Roles Blender always provides (Combined RGBA) and roles it cannot render.
 BUILTIN_ROLES = {"colour", "alpha"}
 
@@ -44,31 +46,42 @@ def wanted_toggles(needs):
 
 
 def apply(scene, filter_name, needs, log=print):
-    """Enables exactly the passes the filter's settings need or use (needs: the native module's
-    needs()) on every view layer of the scene (light passes: on when needed, never turned off)
-    and turns Cycles' own denoiser off. Returns the messages it logged."""
+    """Turns on, on every view layer, the passes the filter's settings need or use (needs: the
+    native module's needs()) and Cycles' own denoiser off, each change recorded (changes.py) so
+    that turning mcrecon off puts it back. Never turns off a pass the user enabled; a pass the
+    add-on itself turned on for earlier settings, and these do not read, goes back to the user's
+    value. Returns the messages it logged."""
     messages = []
+
+    def say(m):
+        messages.append(m)
+        log(m)
     on, unavailable = wanted_toggles(needs)
     for vl in scene.view_layers:
-        for toggle in ROLE_TOGGLES.values():
-            owner = _owner(vl, toggle[0])
-            if owner is not None and hasattr(owner, toggle[1]):
-                setattr(owner, toggle[1], toggle in on)
-        for toggle in LIGHT_TOGGLES.values():
-            if toggle in on and hasattr(vl, toggle[1]):
-                setattr(vl, toggle[1], True)
+        for toggle in {**ROLE_TOGGLES, **LIGHT_TOGGLES}.values():
+            owner = changes.layer_path(vl, toggle[0])
+            if toggle in on:
+                changes.set_value(scene, owner, toggle[1], True, f"'{filter_name}' reads this pass", say)
+            elif changes.changed(scene, owner, toggle[1]):
+                changes.revert(scene, owner, toggle[1], say)
     names = sorted(("cycles." if o else "") + a for o, a in on)
-    messages.append(f"mcrecon: filter '{filter_name}' passes: combined"
-                    + (", " + ", ".join(names) if names else " only"))
+    say(f"mcrecon: filter '{filter_name}' reads: combined" + (", " + ", ".join(names) if names else " only"))
     if unavailable:
-        messages.append(f"mcrecon: Blender does not render {', '.join(unavailable)}; "
-                        f"'{filter_name}' runs without them")
-    if hasattr(scene, "cycles") and scene.cycles.use_denoising:
-        scene.cycles.use_denoising = False
-        messages.append("mcrecon: turned off Cycles denoising (scene.cycles.use_denoising); "
-                        "mcrecon denoises after the render")
+        say(f"mcrecon: Blender does not render {', '.join(unavailable)}; '{filter_name}' runs without them")
+    if hasattr(scene, "cycles"):
+        changes.set_value(scene, "cycles", "use_denoising", False,
+                          "turned off Cycles denoising: mcrecon denoises after the render", say)
     if ("", "use_pass_vector") in on and scene.render.use_motion_blur:
-        messages.append("mcrecon: motion blur is on, so Blender drops the Vector (motion) pass")
-    for m in messages:
-        log(m)
+        say("mcrecon: motion blur is on, so Blender drops the Vector (motion) pass")
     return messages
+
+
+def in_use(scene):
+    """The passes on in the first used view layer, by Blender's names, for the panel."""
+    vl = next((v for v in scene.view_layers if v.use), scene.view_layers[0])
+    names = ["Combined"]
+    for role, (owner, attr) in {**ROLE_TOGGLES, **LIGHT_TOGGLES}.items():
+        obj = getattr(vl, owner) if owner else vl
+        if getattr(obj, attr, False):
+            names.append(role.replace("_", " ").title())
+    return names

@@ -1,7 +1,7 @@
 """Render properties > mcrecon: the switch, the filter and its generated parameters."""
 import bpy
 
-from . import native, properties
+from . import changes, native, passes, properties
 
 
 class MCRECON_PT_render(bpy.types.Panel):
@@ -35,6 +35,14 @@ class MCRECON_PT_render(bpy.types.Panel):
         row = layout.row()
         row.operator("mcrecon.apply_passes")
         row.operator("mcrecon.denoise_files")
+        col = layout.column(align=True)
+        col.label(text="Passes in use: " + ", ".join(passes.in_use(context.scene)))
+        made = changes.listing(context.scene)
+        if made:
+            col.label(text=f"Scene settings changed by mcrecon ({len(made)}):")
+            for line in made:
+                col.label(text=line)
+            col.operator("mcrecon.restore_scene")
         if mc.last_message:
             layout.label(text=mc.last_message, icon="ERROR" if "ERROR" in mc.last_message else "INFO")
 

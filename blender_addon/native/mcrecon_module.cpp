@@ -16,6 +16,8 @@
 #include <utility>
 #include <vector>
 
+#include "io/frame_reader.h"
+#include "io/frame_writer.h"
 #include "io/output_guard.h"
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
@@ -584,6 +586,21 @@ PYBIND11_MODULE(mcrecon, m) {
       "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history; "
       "accumulate=True as --accumulate); progress(done, total, output) is called after each frame. Returns the "
       "outputs written.");
+
+  m.def(
+      "convert_file",
+      [](const std::string& input, const std::string& output, const py::object& display) {
+        const mcr::WriteOptions wo = write_options(false, false, display);
+        mcr::check_output_path(output, {input});
+        mcr::check_write(output, wo);
+        py::gil_scoped_release release;
+        mcr::ReadOptions ro;
+        const mcr::Frame frame = mcr::read_frame(input, ro);
+        mcr::write_result(output, frame.image(mcr::Role::Colour), frame, wo);
+      },
+      py::arg("input"), py::arg("output"), py::arg("display") = py::none(),
+      "Writes the colour (and alpha) of a render or a denoised EXR in the format output's extension names, as "
+      "denoise_file writes its result (display= as there): the add-on turns its denoised EXR into the user's PNG.");
 
   m.def(
       "needs",

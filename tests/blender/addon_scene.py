@@ -259,7 +259,7 @@ def case_errors():
     render(scene, os.path.join(OUT, "png"), 2, 1)
     result["png_render"] = written(scene)
     result["png_message"] = mc.last_message
-    result["png_expected"] = os.path.join(OUT, "png%04d_denoised.exr" % scene.frame_current)
+    result["png_expected"] = os.path.splitext(result["png_render"])[0] + "_denoised.png"  # next to the render
 
 
 def case_composite():
@@ -282,6 +282,85 @@ def case_composite():
     result["message"] = mc.last_message
 
 
+def scene_state(scene):
+    """Every setting the add-on may change, by name."""
+    import mcrecon_addon.passes as passes
+    state = {"cycles.use_denoising": scene.cycles.use_denoising, "use_nodes": scene.use_nodes,
+             "render.use_compositing": scene.render.use_compositing,
+             "nodes": sorted(n.name for n in scene.node_tree.nodes) if scene.node_tree else []}
+    for vl in scene.view_layers:
+        for owner, attr in {**passes.ROLE_TOGGLES, **passes.LIGHT_TOGGLES}.values():
+            obj = getattr(vl, owner) if owner else vl
+            state[vl.name + "." + (owner + "." if owner else "") + attr] = getattr(obj, attr)
+    return state
+
+
+def case_hygiene():
+    """The user's own passes survive every filter; disabling the add-on puts everything back."""
+    import mcrecon_addon.native as native
+    scene = room_scene()
+    vl = scene.view_layers[0]
+    vl.use_pass_vector = True  # the artist's, e.g. for compositor motion blur
+    vl.use_pass_emit = True
+    scene.render.image_settings.file_format = "PNG"  # the add-on adds its pass-file node
+    result["before"] = scene_state(scene)
+    mc = scene.mcrecon
+    mc.enabled = True
+    kept = {}
+    for info in native.get().filters():
+        mc.filter = info["name"]
+        for label, prop in (("", None), (" accumulate", "accumulate"), (" light passes", "light_passes")):
+            if prop:
+                setattr(mc, prop, True)
+            kept[info["name"] + label] = (vl.use_pass_vector, vl.use_pass_emit)
+            if prop:
+                setattr(mc, prop, False)
+    result["user_passes_kept"] = kept
+    mc.filter = "bmfr"
+    result["during"] = scene_state(scene)
+    import mcrecon_addon.changes as changes
+    result["listed_changes"] = changes.listing(scene)
+    addon_utils.disable("mcrecon_addon", default_set=True)
+    result["after_disable"] = scene_state(scene)
+
+
+def case_png_anim():
+    """A 10-frame PNG animation: PNG outputs through the scene's view, nothing left in Blender's
+    temp folder; then F12 without writing: no file written, the result packed."""
+    scene = room_scene()
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.image_settings.color_mode = "RGBA"
+    scene.render.image_settings.color_depth = "8"  # the outputs follow it (16 gives 16-bit PNGs)
+    scene.view_settings.view_transform = "Standard"
+    scene.view_settings.look = "None"
+    scene.frame_start, scene.frame_end = 1, 10
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = "box"
+    tmp = bpy.app.tempdir
+    result["temp_before"] = sorted(os.listdir(tmp))
+    render(scene, os.path.join(OUT, "png_####"), 1, 5, animation=True)
+    result["renders"] = [scene.render.frame_path(frame=f) for f in range(1, 11)]
+    result["outputs"] = [os.path.splitext(p)[0] + "_denoised.png" for p in result["renders"]]
+    result["temp_after"] = sorted(os.listdir(tmp))
+    result["message"] = mc.last_message
+    img = bpy.data.images.get("mcrecon Result")
+    result["packed"] = img is not None and img.packed_file is not None
+    result["fake_user"] = img is not None and img.use_fake_user
+    if result["packed"]:
+        with open(os.path.join(OUT, "packed_last.exr"), "wb") as f:
+            f.write(img.packed_file.data)
+    # F12: render without writing.
+    before = sorted(os.listdir(OUT))
+    scene.frame_set(3)
+    bpy.ops.render.render()
+    result["f12_new_files"] = sorted(set(os.listdir(OUT)) - set(before))
+    result["f12_temp"] = sorted(os.listdir(tmp))
+    img = bpy.data.images.get("mcrecon Result")
+    result["f12_packed"] = img is not None and img.packed_file is not None
+    result["f12_message"] = mc.last_message
+
+
 def case_install_zip():
     scene = bpy.context.scene
     import mcrecon_addon.native as native
@@ -296,6 +375,7 @@ enable_addon()
  "render_auto": lambda: case_render("auto"),
  "passes": case_passes, "anim_bmfr": case_anim, "anim_accumulate": case_anim_accumulate,
  "errors": case_errors, "light_passes": case_light_passes,
- "composite": case_composite, "install_zip": case_install_zip}[CASE]()
+ "composite": case_composite, "install_zip": case_install_zip, "hygiene": case_hygiene,
+ "png_anim": case_png_anim}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

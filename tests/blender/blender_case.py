@@ -141,7 +141,8 @@ def check_light_passes():
     r, log = run_blender()
     assert not any(r["light_before"].values()), r["light_before"]
     assert all(r["light_on"].values()), r["light_on"]
-    assert all(r["light_after_off"].values()), "light passes were turned off: " + str(r["light_after_off"])
+    # The add-on turned them on: off again when no longer needed (the user's value).
+    assert not any(r["light_after_off"].values()), "light passes left on: " + str(r["light_after_off"])
     noisy = r["noisy"]
     den = os.path.splitext(noisy)[0] + "_denoised.exr"
     assert os.path.exists(den), f"missing {den}\n{log[-3000:]}"
@@ -287,6 +288,7 @@ def check_errors():
     # PNG output: rendered as PNG, denoised from the add-on's own pass file.
     assert r["png_render"].endswith(".png") and os.path.exists(r["png_render"]), r["png_render"]
     assert "ERROR" not in r["png_message"] and os.path.exists(r["png_expected"]), r["png_message"]
+    assert oiio.ImageInput.open(r["png_expected"]).format_name() == "png", "a PNG render gave no PNG output"
     assert "Traceback" not in log
     print(f"png: {r['png_message']}")
 
@@ -307,6 +309,53 @@ def check_composite():
     assert abs(got - comp) < 0.05 * max(1.0, abs(comp)) and abs(got - raw) > 0.1, "did not denoise the composite"
 
 
+def check_hygiene():
+    """Issue 16 point 2: passes the user enabled stay on whatever is chosen; disabling the add-on
+    restores every setting it changed."""
+    r, log = run_blender()
+    lost = {k: v for k, v in r["user_passes_kept"].items() if v != [True, True]}
+    assert not lost, f"the user's Vector / Emission passes were turned off by: {lost}"
+    changed = {k for k in r["before"] if r["during"][k] != r["before"][k]}
+    assert {"cycles.use_denoising", "use_nodes", "render.use_compositing"} <= changed, changed
+    assert len(r["listed_changes"]) >= len(changed) - 1, r["listed_changes"]  # nodes: one line each
+    diff = {k: (r["before"][k], r["after_disable"][k]) for k in r["before"] if r["before"][k] != r["after_disable"][k]}
+    assert not diff, f"settings not restored when the add-on was disabled: {diff}"
+    assert "turning mcrecon off puts it back" in log
+    print(f"hygiene: user passes kept over {len(r['user_passes_kept'])} settings; {len(changed)} changed "
+          f"settings restored on disable")
+
+
+def check_png_anim():
+    """Issue 16 point 3: no file left in Blender's temp folder after a 10-frame animation; a PNG
+    render gives PNG denoised outputs (the Standard view of the denoised result); F12 writes nothing."""
+    r, log = run_blender()
+    assert "ERROR" not in r["message"], r["message"]
+    for p in r["renders"] + r["outputs"]:
+        assert os.path.exists(p), f"missing {p}\n{log[-3000:]}"
+    for p in r["outputs"]:
+        inp = oiio.ImageInput.open(p)
+        assert inp.format_name() == "png" and inp.spec().format == "uint8", (p, inp.format_name())
+        inp.close()
+    left = sorted(set(r["temp_after"]) - set(r["temp_before"]))
+    assert not left, f"files left in Blender's temp folder: {left}"
+    assert r["packed"] and r["fake_user"], "the result is not packed with a fake user"
+    # The last frame's PNG is the Standard view (the sRGB curve) of the packed denoised result.
+    lin = oiio.ImageBuf(os.path.join(OUT, "packed_last.exr")).get_pixels(oiio.FLOAT).astype(np.float64)
+    straight = np.clip(lin[..., :3] / np.maximum(lin[..., 3:4], 1e-30), 0, 1)
+    srgb = np.where(straight <= 0.0031308, 12.92 * straight, 1.055 * straight ** (1 / 2.4) - 0.055)
+    cfg = oiio.ImageSpec()
+    cfg.attribute("oiio:UnassociatedAlpha", 1)
+    inp = oiio.ImageInput.open(r["outputs"][-1], cfg)
+    png = inp.read_image(0, 0, 0, 3, "float").astype(np.float64)
+    inp.close()
+    err = np.abs(png - srgb).max() * 255
+    assert err <= 0.6, f"the PNG is {err:.2f} codes off the Standard view of the denoised result"  # rounding + OCIO
+    assert r["f12_new_files"] == [], r["f12_new_files"]
+    assert not sorted(set(r["f12_temp"]) - set(r["temp_before"])), r["f12_temp"]
+    assert r["f12_packed"] and "ERROR" not in r["f12_message"], r["f12_message"]
+    print(f"png_anim: 10 PNG outputs, temp folder clean, last frame within {err:.2f} codes; F12 wrote nothing")
+
+
 def check_install_zip():
     r, log = run_blender()
     assert r["has_settings"] and r["panel"]
@@ -320,5 +369,6 @@ def check_install_zip():
  "render_bilateral": lambda: check_render("bilateral", box_radius=bilateral_radius()),
  "passes": check_passes, "anim_bmfr": check_anim, "anim_accumulate": check_anim_accumulate,
  "errors": check_errors, "light_passes": check_light_passes,
- "composite": check_composite, "install_zip": check_install_zip}[CASE]()
+ "composite": check_composite, "install_zip": check_install_zip, "hygiene": check_hygiene,
+ "png_anim": check_png_anim}[CASE]()
 print("OK")

@@ -291,6 +291,10 @@ class AddonOutputNames(unittest.TestCase):
         self.assertEqual(op.output_for_frame("/r/out.exr", 3, False), "/r/out.exr")  # a still
         self.assertEqual(op.output_for_frame("/r/o_##.exr", 3, True), "/r/o_03.exr")
         self.assertEqual(op.output_for_frame("/r/o_##.exr", 3, False), "/r/o_03.exr")
+        # The render's format when the name has none mcrecon writes; a name's own format kept.
+        self.assertEqual(op.output_for_frame("/r/out", 2, True, ".png"), "/r/out0002.png")
+        self.assertEqual(op.output_for_frame("/r/out.tif", 2, True, ".png"), "/r/out0002.tif")
+        self.assertEqual(op.output_for_frame("/r/out.v2", 2, False, ".jpg"), "/r/out.v2.jpg")
         frames = [op.output_for_frame("/r/out.exr", f, True) for f in range(1, 11)]
         self.assertEqual(len(set(frames)), 10)
 
