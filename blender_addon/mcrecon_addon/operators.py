@@ -1,10 +1,10 @@
-"""Operators: mcrecon.denoise_files (re-denoise saved multilayer EXR sequences) and
-mcrecon.apply_passes (enable the chosen filter's passes, with a report)."""
+"""Operators: mcrecon.denoise_files (re-denoise saved multilayer EXR sequences, modal with Esc),
+mcrecon.apply_passes (enable the chosen filter's passes, with a report), mcrecon.restore_scene."""
 import os
 
 import bpy
 
-from . import changes, native, pass_output, properties
+from . import changes, native, output_paths, pass_output, properties
 
 
 _ITEMS = []  # Blender needs the strings of dynamic enum items kept alive
@@ -17,68 +17,131 @@ def _filter_items(self, context):
 
 
 class MCRECON_OT_denoise_files(bpy.types.Operator):
-    """Denoise saved multilayer EXR renders (a #### sequence, in frame order, one temporal history)"""
+    """Denoise saved multilayer EXR renders: pick one file of a sequence and every frame of it found on disk is denoised in frame order (Esc stops after the current frame)"""
     bl_idname = "mcrecon.denoise_files"
     bl_label = "Denoise EXR Files"
     bl_options = {"REGISTER"}
 
     filepath: bpy.props.StringProperty(name="Input", subtype="FILE_PATH",
-                                       description="Multilayer EXR, or a sequence pattern with ####")
+                                       description="One multilayer EXR of the sequence (or a #### pattern)")
     output: bpy.props.StringProperty(name="Output", subtype="FILE_PATH", default="",
                                      description="Output (with #### for sequences); empty: <input>_denoised.exr")
-    frame_start: bpy.props.IntProperty(name="Start", default=1)
-    frame_end: bpy.props.IntProperty(name="End", default=1)
+    sequence: bpy.props.BoolProperty(name="Whole Sequence", default=True,
+                                     description="Denoise every frame of the picked file's sequence found on disk "
+                                                 "(off: only the picked file)")
+    frame_start: bpy.props.IntProperty(name="Start", default=0, min=0,
+                                       description="First frame (0: the first found on disk)")
+    frame_end: bpy.props.IntProperty(name="End", default=0, min=0,
+                                     description="Last frame (0: the last found on disk)")
     filter: bpy.props.EnumProperty(name="Filter", items=_filter_items,
                                    description="Filter (parameters from the scene's mcrecon settings)")
     accumulate: bpy.props.BoolProperty(name="Accumulate", default=False,
                                        description="Temporal accumulation before the filter (--accumulate)")
 
+    _timer = None
+
     def invoke(self, context, event):
         self.filter = context.scene.mcrecon.filter
         self.accumulate = context.scene.mcrecon.accumulate
-        self.frame_start, self.frame_end = context.scene.frame_start, context.scene.frame_end
         context.window_manager.fileselect_add(self)
         return {"RUNNING_MODAL"}
 
+    def _plan(self, context):
+        """(jobs [(frame, input, output)], messages); raises ValueError with the reason."""
+        src = bpy.path.abspath(self.filepath)
+        pattern, found = output_paths.sequence_of(src) if self.sequence or "#" in src else (src, [])
+        lo = self.frame_start or (found[0] if found else 0)
+        hi = self.frame_end or (found[-1] if found else 0)
+        frames = [f for f in found if lo <= f <= hi]
+        out = bpy.path.abspath(self.output) if self.output else os.path.splitext(pattern)[0] + "_denoised.exr"
+        if "#" not in pattern:
+            return [(None, src, out)], []
+        if not frames:
+            raise ValueError(f"no frame of '{pattern}' between {lo} and {hi} on disk")
+        if "#" not in out:
+            raise ValueError(f"output '{out}' must contain #### for the sequence '{pattern}'")
+        messages = []
+        spans = output_paths.runs(frames)
+        if len(spans) > 1:
+            messages.append("frames missing between " + ", ".join(f"{a}-{b}" for a, b in spans) +
+                            ": the history restarts after each gap")
+        return [(f, output_paths.frame_path(pattern, f), output_paths.frame_path(out, f)) for f in frames], messages
+
     def execute(self, context):
         mc = native.get()
-        src = bpy.path.abspath(self.filepath)
-        out = bpy.path.abspath(self.output) if self.output else os.path.splitext(src)[0] + "_denoised.exr"
-        seq = "#" in src
-        frames = list(range(self.frame_start, self.frame_end + 1)) if seq else [None]
-        if seq and "#" not in out:
-            self.report({"ERROR"}, "mcrecon: output '%s' must contain #### for the sequence input '%s'" % (out, src))
-            return {"CANCELLED"}
-        if not frames:
-            self.report({"ERROR"}, f"mcrecon: empty frame range {self.frame_start}-{self.frame_end}")
-            return {"CANCELLED"}
-        wm = context.window_manager
-        params = properties.filter_params(context.scene.mcrecon, self.filter)
-        # The core checks the outputs before any frame is filtered (never an input, every frame its
-        # own regular file or new path): an error is reported, nothing is written.
         try:
-            wm.progress_begin(0, len(frames))
-            try:
-                if seq:
-                    def progress(n, total, o):
-                        wm.progress_update(n)
-                        print(f"mcrecon: [{n}/{total}] {o}", flush=True)
-                    mc.denoise_sequence(src, out, self.frame_start, self.frame_end, self.filter, params,
-                                        progress=progress, accumulate=self.accumulate,
-                                        keep_components=context.scene.mcrecon.keep_components)
-                else:
-                    t = mc.Session(self.filter, params, accumulate=self.accumulate).denoise_file(
-                        src, out, keep_components=context.scene.mcrecon.keep_components)
-                    print(f"mcrecon: {out} ({t['total_ms']:.0f} ms)", flush=True)
-                    for note in t["notes"]:  # auto: its scores and choice
-                        self.report({"INFO"}, f"mcrecon: {note}")
-            finally:
-                wm.progress_end()
-        except mc.Error as e:
-            self.report({"ERROR"}, f"mcrecon: {e} [{e.kind}]")
+            self._jobs, notes = self._plan(context)
+            params = properties.filter_params(context.scene.mcrecon, self.filter)
+            outputs = [o for _, _, o in self._jobs]
+            inputs = [i for _, i, _ in self._jobs]
+            mc.check_outputs(outputs, inputs)  # nothing is filtered when one output is wrong
+            self._session = mc.Session(self.filter, params, accumulate=self.accumulate)
+        except (ValueError, mc.Error) as e:
+            self.report({"ERROR"}, f"mcrecon: {e}" + (f" [{e.kind}]" if isinstance(e, mc.Error) else ""))
             return {"CANCELLED"}
-        self.report({"INFO"}, f"mcrecon: {len(frames)} file(s) denoised with {self.filter}")
+        for m in notes:
+            self.report({"WARNING"}, "mcrecon: " + m)
+        self._done, self._last = 0, None
+        wm = context.window_manager
+        wm.progress_begin(0, len(self._jobs))
+        if context.window is None or bpy.app.background:  # a script: all frames now
+            while self._done < len(self._jobs):
+                if not self._step(context):
+                    return {"CANCELLED"}
+            return self._finish(context, cancelled=False)
+        self._timer = wm.event_timer_add(0.01, window=context.window)
+        wm.modal_handler_add(self)
+        return {"RUNNING_MODAL"}
+
+    def _step(self, context):
+        """Denoises one frame; False after an error (reported)."""
+        mc = native.get()
+        frame, src, out = self._jobs[self._done]
+        if frame is not None and self._last is not None and frame != self._last + 1:
+            self._session.reset()  # a gap: no history across it
+        try:
+            t = self._session.denoise_file(src, out, keep_components=context.scene.mcrecon.keep_components)
+        except mc.Error as e:
+            self.report({"ERROR"}, f"mcrecon: {e} [{e.kind}] ({self._done} of {len(self._jobs)} done)")
+            context.window_manager.progress_end()
+            return False
+        self._done += 1
+        self._last = frame
+        context.window_manager.progress_update(self._done)
+        print(f"mcrecon: [{self._done}/{len(self._jobs)}] {out} ({t['total_ms']:.0f} ms)", flush=True)
+        if len(self._jobs) == 1:
+            for note in t["notes"]:  # auto: its scores and choice
+                self.report({"INFO"}, f"mcrecon: {note}")
+        if context.area:
+            context.area.header_text_set(f"mcrecon: denoised {self._done} of {len(self._jobs)} (Esc to stop)")
+        return True
+
+    def _finish(self, context, cancelled):
+        wm = context.window_manager
+        if self._timer is not None:
+            wm.event_timer_remove(self._timer)
+            self._timer = None
+        wm.progress_end()
+        if context.area:
+            context.area.header_text_set(None)
+        if cancelled:
+            self.report({"WARNING"}, f"mcrecon: stopped after {self._done} of {len(self._jobs)} file(s); "
+                                     "every output written is complete")
+            return {"CANCELLED"}
+        self.report({"INFO"}, f"mcrecon: {self._done} file(s) denoised with {self.filter}")
         return {"FINISHED"}
+
+    def modal(self, context, event):
+        if event.type == "ESC":
+            return self._finish(context, cancelled=True)
+        if event.type == "TIMER":
+            if not self._step(context):
+                self._timer and context.window_manager.event_timer_remove(self._timer)
+                self._timer = None
+                return {"CANCELLED"}
+            if self._done == len(self._jobs):
+                return self._finish(context, cancelled=False)
+        return {"RUNNING_MODAL"}
 
 
 class MCRECON_OT_apply_passes(bpy.types.Operator):

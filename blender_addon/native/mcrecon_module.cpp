@@ -588,6 +588,16 @@ PYBIND11_MODULE(mcrecon, m) {
       "outputs written.");
 
   m.def(
+      "check_outputs",
+      [](const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
+        mcr::check_output_paths(outputs, inputs);
+        for (const std::string& o : outputs) mcr::check_write(o, mcr::WriteOptions{});
+      },
+      py::arg("outputs"), py::arg("inputs"),
+      "Raises mcrecon.Error unless every output may be written as the CLI would: never an input, never "
+      "two outputs one file, only a regular file or a new path, a format its extension names.");
+
+  m.def(
       "convert_file",
       [](const std::string& input, const std::string& output, const py::object& display) {
         const mcr::WriteOptions wo = write_options(false, false, display);

@@ -361,6 +361,20 @@ def case_png_anim():
     result["f12_message"] = mc.last_message
 
 
+def case_denoise_files():
+    """Denoise EXR Files given one file of a sequence with a gap, no range: every frame on disk."""
+    import shutil
+    seq = os.path.join(OUT, "seq")
+    os.makedirs(seq)
+    sample = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_%04d.exr")
+    for f in (1, 2, 3, 4, 6):
+        shutil.copyfile(sample % f, os.path.join(seq, "shot_%04d.exr" % f))
+    r = bpy.ops.mcrecon.denoise_files(filepath=os.path.join(seq, "shot_0003.exr"), filter="box", accumulate=True)
+    result["operator"] = sorted(r)
+    result["listing"] = sorted(os.listdir(seq))
+    result["seq"] = seq
+
+
 def case_install_zip():
     scene = bpy.context.scene
     import mcrecon_addon.native as native
@@ -376,6 +390,6 @@ enable_addon()
  "passes": case_passes, "anim_bmfr": case_anim, "anim_accumulate": case_anim_accumulate,
  "errors": case_errors, "light_passes": case_light_passes,
  "composite": case_composite, "install_zip": case_install_zip, "hygiene": case_hygiene,
- "png_anim": case_png_anim}[CASE]()
+ "png_anim": case_png_anim, "denoise_files": case_denoise_files}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

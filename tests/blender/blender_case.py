@@ -356,6 +356,25 @@ def check_png_anim():
     print(f"png_anim: 10 PNG outputs, temp folder clean, last frame within {err:.2f} codes; F12 wrote nothing")
 
 
+def check_denoise_files():
+    """Issue 16: one picked file gives the frames on disk (1-4 and 6, no range typed); the history
+    restarts after the gap, as separate `mcrecon denoise --accumulate` runs of 1-4 and of 6 give."""
+    r, log = run_blender()
+    assert r["operator"] == ["FINISHED"], r["operator"] + [log[-3000:]]
+    want = ["shot_%04d.exr" % f for f in (1, 2, 3, 4, 6)] + ["shot_%04d_denoised.exr" % f for f in (1, 2, 3, 4, 6)]
+    assert r["listing"] == sorted(want), r["listing"]
+    assert "history restarts after each gap" in log, log[-2000:]
+    seq = r["seq"]
+    ref = os.path.join(OUT, "ref_####.exr")
+    cli_denoise(os.path.join(seq, "shot_####.exr"), ref, "box", extra=["--frames", "1-4", "--accumulate"])
+    cli_denoise(os.path.join(seq, "shot_0006.exr"), os.path.join(OUT, "ref_0006.exr"), "box", extra=["--accumulate"])
+    for f in (1, 2, 3, 4, 6):
+        (na, pa), (nb, pb) = all_channels(os.path.join(seq, "shot_%04d_denoised.exr" % f)), \
+            all_channels(os.path.join(OUT, "ref_%04d.exr" % f))
+        assert na == nb and np.array_equal(pa.view(np.uint32), pb.view(np.uint32)), f"frame {f} differs from the CLI"
+    print("denoise_files: frames 1-4 and 6 found from one picked file, history reset at the gap, CLI bit for bit")
+
+
 def check_install_zip():
     r, log = run_blender()
     assert r["has_settings"] and r["panel"]
@@ -370,5 +389,5 @@ def check_install_zip():
  "passes": check_passes, "anim_bmfr": check_anim, "anim_accumulate": check_anim_accumulate,
  "errors": check_errors, "light_passes": check_light_passes,
  "composite": check_composite, "install_zip": check_install_zip, "hygiene": check_hygiene,
- "png_anim": check_png_anim}[CASE]()
+ "png_anim": check_png_anim, "denoise_files": check_denoise_files}[CASE]()
 print("OK")

@@ -298,6 +298,24 @@ class AddonOutputNames(unittest.TestCase):
         frames = [op.output_for_frame("/r/out.exr", f, True) for f in range(1, 11)]
         self.assertEqual(len(set(frames)), 10)
 
+    def test_a_sequence_is_found_from_one_of_its_files(self):
+        op = output_paths()
+        d = tempfile.mkdtemp(prefix="mcrecon_seq_")
+        try:
+            for name in ("shot_v2_0001.exr", "shot_v2_0002.exr", "shot_v2_0003.exr", "shot_v2_0007.exr",
+                         "shot_v2_10000.exr", "shot_v2_0004.png", "shot_v2_004.exr", "other_0005.exr",
+                         "shot_v2_0005.exr.bak", "shot_v2_0006_denoised.exr"):
+                open(os.path.join(d, name), "w").close()
+            pattern, frames = op.sequence_of(os.path.join(d, "shot_v2_0002.exr"))
+            self.assertEqual(pattern, os.path.join(d, "shot_v2_####.exr"))
+            self.assertEqual(frames, [1, 2, 3, 7, 10000])
+            self.assertEqual(op.runs(frames), [(1, 3), (7, 7), (10000, 10000)])
+            self.assertEqual(op.sequence_of(os.path.join(d, "still.exr")), (os.path.join(d, "still.exr"), []))
+            self.assertEqual(op.sequence_of(os.path.join(d, "shot_v2_####.exr"))[1], [1, 2, 3, 7, 10000])
+            self.assertEqual(op.sequence_of("/nowhere/s_####.exr"), ("/nowhere/s_####.exr", []))
+        finally:
+            shutil.rmtree(d)
+
 
 if __name__ == "__main__":
     unittest.main(verbosity=2)
