@@ -1,8 +1,9 @@
 """scene.mcrecon: settings plus one PropertyGroup per filter, generated from the parameter
-tables of the native module (names, types, defaults, ranges, choices and help)."""
+tables of the native module (names, types, defaults, ranges, choices and help; labels, tooltips
+and menus as panel_layout.py words them)."""
 import bpy
 
-from . import native, pass_output, passes
+from . import native, pass_output, panel_layout, passes
 
 INT32 = 2**31 - 1
 _classes = []          # registered classes, in order
@@ -19,8 +20,12 @@ def prop_name(param):
 
 
 def _property(spec):
-    t, desc = spec["type"], spec["help"]
-    common = dict(name=spec["name"], description=desc, update=_on_param_change)
+    t = spec["type"]
+    common = dict(name=panel_layout.label(spec["name"]), description=panel_layout.tooltip(spec),
+                  update=_on_param_change)
+    choices = panel_layout.int_choices(spec)
+    if choices:  # a small integer whose values have names: a menu
+        return bpy.props.EnumProperty(items=choices, default=str(int(spec["default"])), **common)
     if t == "int":
         lo, hi = max(int(spec["min"]), -INT32), min(int(spec["max"]), INT32)
         return bpy.props.IntProperty(default=int(spec["default"]), min=lo, max=hi, **common)
@@ -30,9 +35,15 @@ def _property(spec):
     if t == "bool":
         return bpy.props.BoolProperty(default=bool(spec["default"]), **common)
     if t == "enum":
-        items = [(c, c, desc) for c in spec["choices"]]
+        items = [(c, c.replace("_", " ").title(), spec["help"]) for c in spec["choices"]]
         return bpy.props.EnumProperty(items=items, default=spec["default"], **common)
     raise ValueError(f"parameter {spec['name']}: unknown type {t}")
+
+
+def value_of(group, filter_name, spec):
+    """A parameter's value as the table types it (a menu of integers gives its int)."""
+    v = getattr(group, _prop_names[filter_name][spec["name"]])
+    return int(v) if spec["type"] == "int" and isinstance(v, str) else v
 
 
 def _filter_group(info):
@@ -56,7 +67,7 @@ def filter_params(settings, filter_name):
     group = getattr(settings, group_attr(filter_name))
     out = {}
     for spec in info["parameters"]:
-        v = getattr(group, _prop_names[filter_name][spec["name"]])
+        v = value_of(group, filter_name, spec)
         d = spec["default"]
         if spec["type"] == "float":
             if abs(v - d) <= 1e-6 * max(1.0, abs(d)):
@@ -134,17 +145,17 @@ def _base_annotations():
                         "filter (as mcrecon denoise --accumulate; needs the Position and Normal passes, uses "
                         "Vector); history restarts on a frame jump"),
         "light_passes": bpy.props.BoolProperty(
-            name="Denoise light passes", default=False, update=_on_filter_change,
+            name="Denoise Light Passes", default=False, update=_on_filter_change,
             description="Denoise Blender's diffuse, glossy and transmission light one by one, each by its own "
                         "colour pass, and add them up (components=light_passes; turns the light passes on: "
                         "Diffuse, Glossy, Transmission Direct/Indirect/Color, Emission, Environment)"),
         "keep_components": bpy.props.BoolProperty(
-            name="Keep components", default=False,
+            name="Keep Components", default=False,
             description="With Denoise light passes: write each denoised component as its own layer of the output "
                         "(<layer>.Denoised.Diffuse, Glossy, Transmission, Emission, Environment), summing to "
                         "the beauty (mcrecon denoise --keep-components)"),
         "extra_params": bpy.props.StringProperty(
-            name="Extra parameters", default="", update=_on_filter_change,
+            name="Extra Parameters", default="", update=_on_filter_change,
             description="Advanced: KEY=VALUE pairs passed to the filter as they are (like mcrecon denoise --set)"),
         "last_message": bpy.props.StringProperty(name="Last message", default=""),
     }
@@ -160,7 +171,7 @@ def register():
         _classes.append(cls)
         ann[group_attr(info["name"])] = bpy.props.PointerProperty(type=cls)
     ann["filter"] = bpy.props.EnumProperty(
-        name="Filter", items=[(i["name"], i["name"], i["summary"]) for i in infos],
+        name="Filter", items=[(i["name"], panel_layout.filter_label(i["name"]), i["summary"]) for i in infos],
         # auto: a new user gets the filter that suits the render (and the passes it may read).
         default="auto", update=_on_filter_change,
         description="mcrecon filter (Render properties show its parameters)")

@@ -37,11 +37,18 @@ def log(scene, text, error=False):
     except Exception:  # read-only contexts (render thread of some builds)
         pass
     if error:
-        # Also a real Blender report, so it shows in the Info editor and status bar.
-        try:
-            bpy.ops.mcrecon.report(message=text, level='ERROR')
-        except Exception:  # no operator context in this handler: the console line stands
-            pass
+        # Also a real Blender report, in full, in the Info editor and the status bar: from the
+        # main loop (handlers run in the render thread, where operators have no context).
+        def report():
+            try:
+                bpy.ops.mcrecon.report(message=text, level='ERROR')
+            except Exception:  # no window (background): the console line stands
+                pass
+            return None
+        if bpy.app.background:
+            report()
+        else:
+            bpy.app.timers.register(report, first_interval=0.0)
 
 
 def written_path(scene):

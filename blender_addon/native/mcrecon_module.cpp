@@ -588,6 +588,37 @@ PYBIND11_MODULE(mcrecon, m) {
       "outputs written.");
 
   m.def(
+      "inactive_parameters",
+      [](const std::string& filter, const py::dict& params) {
+        // A parameter is inactive when, given explicitly, the filter would call it unused
+        // under these settings (Filter::unused_settings: "<name> has no effect ...").
+        const auto base = params_from_dict(params);
+        const auto probe = mcr::make_committed_filter(filter, base);
+        auto has_no_effect = [](const mcr::Filter& f, const std::string& name) {
+          for (const std::string& line : f.unused_settings())
+            if (line.rfind(name + " has no effect", 0) == 0) return true;
+          return false;
+        };
+        std::vector<std::string> out;
+        for (const mcr::ParamSpec& spec : probe->info().params) {
+          bool given = false;
+          for (const auto& kv : base) given = given || kv.first == spec.name;
+          if (given) {
+            if (has_no_effect(*probe, spec.name)) out.push_back(spec.name);
+            continue;
+          }
+          auto with = base;
+          with.emplace_back(spec.name, mcr::param_value_text(spec.default_value));
+          if (has_no_effect(*mcr::make_committed_filter(filter, with), spec.name)) out.push_back(spec.name);
+        }
+        return out;
+      },
+      py::arg("filter"), py::arg("params") = py::dict(),
+      "The parameters that have no effect under these settings (the foveation set without foveated=true, "
+      "a feature's sigma with its weight off, ...), as `mcrecon denoise --verbose` would note them: the "
+      "add-on's panel hides them.");
+
+  m.def(
       "check_outputs",
       [](const std::vector<std::string>& outputs, const std::vector<std::string>& inputs) {
         mcr::check_output_paths(outputs, inputs);

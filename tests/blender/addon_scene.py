@@ -104,9 +104,10 @@ def case_passes():
     for info in native.get().filters():
         mc.filter = info["name"]
         group = getattr(mc, "params_" + info["name"])
+        from mcrecon_addon import properties as props
         defaults_ok = all(
             (abs(getattr(group, s["name"]) - s["default"]) <= 1e-6 * max(1, abs(s["default"])))
-            if s["type"] == "float" else getattr(group, s["name"]) == s["default"]
+            if s["type"] == "float" else props.value_of(group, info["name"], s) == s["default"]
             for s in info["parameters"])
         seen[info["name"]] = {"toggles": toggles(scene), "defaults_ok": defaults_ok, "roles": roles(info["name"])}
     result["filters"] = seen
@@ -127,7 +128,8 @@ def case_passes():
     mc.filter = "box"
     switched_on(mc, "accumulate", "box accumulate", "box", accumulate=True)
     result["settings"] = settings
-    # The panel draws every parameter of the chosen filter (recorded by a stand-in layout).
+    # The panels draw the chosen filter's parameters that have an effect (recorded by a stand-in
+    # layout), the main panel only its main settings; the rest in the sub-panels.
     drawn = []
 
     class Layout:
@@ -141,11 +143,29 @@ def case_passes():
 
     class Panel:
         layout = Layout()
-    for name in ("box", "bilateral"):
+    subs = ("MCRECON_PT_features", "MCRECON_PT_fireflies", "MCRECON_PT_foveation", "MCRECON_PT_advanced")
+    for name, params in (("box", {}), ("bilateral", {}), ("bilateral", {"foveated": True, "order": "1"})):
         mc.filter = name
+        group = getattr(mc, "params_" + name)
+        for k, v in params.items():
+            setattr(group, k, v)
         drawn.clear()
         bpy.types.MCRECON_PT_render.draw(Panel(), bpy.context)
-        result.setdefault("panel", {})[name] = list(drawn)
+        main = list(drawn)
+        for sub in subs:
+            cls = getattr(bpy.types, sub)
+            if cls.poll(bpy.context):
+                stand_in = type("Sub", (), {"layout": Layout(), "group": cls.group})()
+                if hasattr(cls, "draw_header"):
+                    cls.draw_header(stand_in, bpy.context)
+                cls.draw(stand_in, bpy.context)
+        key = name + ("".join(" %s=%s" % kv for kv in params.items()))
+        result.setdefault("panel", {})[key] = {"main": main, "all": list(drawn),
+                                               "inactive": native.get().inactive_parameters(
+                                                   name, {k: (int(v) if k == "order" else v)
+                                                          for k, v in params.items()})}
+        for k in params:
+            group.property_unset(k)
     result["role_toggles"] = {r: (o + "." if o else "") + a for r, (o, a) in passes.ROLE_TOGGLES.items()}
     # The operator does the same and reports.
     mc.filter = "box"

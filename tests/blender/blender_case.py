@@ -203,11 +203,19 @@ def check_passes():
     assert t["use_pass_normal"] and t["use_pass_position"] and t["use_pass_z"] \
         and t["cycles.denoising_store_passes"] and not t["use_pass_vector"], t
     assert not any(r["after_operator_box"].values())
-    for name, drawn in r["panel"].items():
-        params = [p["name"] for p in mcrecon.filter_info(name)["parameters"]]
-        assert all(p in drawn for p in params), f"panel for {name} lacks {set(params) - set(drawn)}"
-        assert "filter" in drawn and "output_path" in drawn
-    print("panel draws the chosen filter's parameters")
+    for key, d in r["panel"].items():
+        name = key.split()[0]
+        params = [p["name"] for p in mcrecon.filter_info(name)["parameters"] if p["name"] != "components"]
+        active = [p for p in params if p not in d["inactive"]]
+        assert all(p in d["all"] for p in active), f"panels for {key} lack {set(active) - set(d['all'])}"
+        shown_inactive = set(d["inactive"]) & set(d["all"]) - {"foveated"}
+        assert not shown_inactive, f"panels for {key} show settings with no effect: {shown_inactive}"
+        assert "filter" in d["main"] and "output_path" in d["main"]
+        assert len(d["main"]) <= 10, f"{key}: the main panel lists {len(d['main'])} settings: {d['main']}"
+    assert "gaze_x" in r["panel"]["bilateral foveated=True order=1"]["all"]
+    assert "ridge" in r["panel"]["bilateral foveated=True order=1"]["all"]
+    assert "gaze_x" not in r["panel"]["bilateral"]["all"] and "ridge" not in r["panel"]["bilateral"]["all"]
+    print("panels: main settings first, the rest grouped; settings without effect hidden")
 
 
 def check_anim():
