@@ -2,7 +2,8 @@
 with every Blender light pass (light_passes_testutil.py).
 
 Oracles: each component run alone through the CLI as an ordinary beauty (a file whose Combined is
-that component's direct + indirect light, with the same features), multiplied by its colour pass in
+that component's direct + indirect light, with the same features; glossy and transmission: its
+direct and its indirect light each alone, added after filtering), multiplied by its colour pass in
 numpy, plus Emit and Env, is the light_passes output; the written component layers add up to the
 written beauty within 1e-5 relative per pixel; a missing light pass is refused naming it and the
 file; --keep-components without light passes is refused.
