@@ -48,7 +48,8 @@ SCENES = {
                            "tap, kettle and bevelled toaster, a brushed-steel tray, a glass and a "
                            "mug on a wooden counter before glossy tiles, lit by one small, strong "
                            "point lamp (its highlights slide over the chrome) and a dim world; "
-                           "indirect clamp off; held out: never used to choose settings."),
+                           "indirect clamp off; with the light passes; held out: never used to "
+                           "choose settings."),
 }
 ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.

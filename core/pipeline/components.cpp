@@ -44,11 +44,37 @@ float clamped(float v) {
 
 const std::vector<LightComponent>& light_components() {
   static const std::vector<LightComponent> list = {
-      {"diffuse", "Diffuse", Role::DiffuseDirect, Role::DiffuseIndirect, Role::DiffuseColour},
-      {"glossy", "Glossy", Role::GlossyDirect, Role::GlossyIndirect, Role::GlossyColour},
-      {"transmission", "Transmission", Role::TransmissionDirect, Role::TransmissionIndirect, Role::TransmissionColour},
+      {"diffuse", "Diffuse", Role::DiffuseDirect, Role::DiffuseIndirect, Role::DiffuseColour, false},
+      {"glossy", "Glossy", Role::GlossyDirect, Role::GlossyIndirect, Role::GlossyColour, true},
+      {"transmission", "Transmission", Role::TransmissionDirect, Role::TransmissionIndirect, Role::TransmissionColour,
+       true},
   };
   return list;
+}
+
+const std::vector<LightStage>& light_stages() {
+  static const std::vector<LightStage> list = [] {
+    std::vector<LightStage> l;
+    for (std::size_t i = 0; i < light_components().size(); ++i) {
+      if (!light_components()[i].split) {
+        l.push_back({i, LightPart::Both});
+        continue;
+      }
+      l.push_back({i, LightPart::Direct});
+      l.push_back({i, LightPart::Indirect});
+    }
+    return l;
+  }();
+  return list;
+}
+
+std::string light_stage_name(const LightStage& stage) {
+  const std::string name = light_components()[stage.component].name;
+  switch (stage.part) {
+    case LightPart::Direct: return name + " direct";
+    case LightPart::Indirect: return name + " indirect";
+    default: return name;
+  }
 }
 
 const std::vector<std::string>& component_layer_names() {
@@ -98,7 +124,7 @@ void check_light_passes(const Frame& frame) {
                   "view layer, or use components=beauty)");
 }
 
-Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads) {
+Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads, LightPart part) {
   Frame out;
   out.width = frame.width;
   out.height = frame.height;
@@ -134,23 +160,37 @@ Frame component_frame(const Frame& frame, const LightComponent& component, int n
   out.passes.push_back(std::move(albedo));
   Pass light;
   light.role = Role::Colour;
-  light.name = direct.name + "+" + indirect.name;
+  light.name = part == LightPart::Direct     ? direct.name
+               : part == LightPart::Indirect ? indirect.name
+                                             : direct.name + "+" + indirect.name;
   light.source = direct.source;
   light.priority = 3;
   light.image = Image(frame.width, frame.height, 3);
   const Image& a = direct.image;
   const Image& b = indirect.image;
   const int ca = a.channels(), cb = b.channels();
+  const bool with_a = part != LightPart::Indirect, with_b = part != LightPart::Direct;
   parallel_rows(0, frame.height, nthreads, [&](int y) {
     for (int x = 0; x < frame.width; ++x) {
       const float* pa = a.pixel(x, y);
       const float* pb = b.pixel(x, y);
       float* o = light.image.pixel(x, y);
-      for (int c = 0; c < 3; ++c) o[c] = pa[c < ca ? c : 0] + pb[c < cb ? c : 0];
+      for (int c = 0; c < 3; ++c) o[c] = (with_a ? pa[c < ca ? c : 0] : 0.0f) + (with_b ? pb[c < cb ? c : 0] : 0.0f);
     }
   });
   out.passes.push_back(std::move(light));
   return out;
+}
+
+void add_light(Image& sum, const Image& part, int nthreads) {
+  if (sum.width() != part.width() || sum.height() != part.height() || sum.channels() != part.channels())
+    throw Error(Errc::Internal, "add_light: parts of different shape");
+  const int w = sum.width(), ch = sum.channels();
+  parallel_rows(0, sum.height(), nthreads, [&](int y) {
+    float* s = sum.pixel(0, y);
+    const float* p = part.pixel(0, y);
+    for (int i = 0; i < w * ch; ++i) s[i] = clamped(s[i] + p[i]);
+  });
 }
 
 Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int nthreads) {

@@ -47,7 +47,7 @@ Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate) 
     }
     filter->commit();
   }
-  const std::size_t count = split ? light_components().size() : 1;
+  const std::size_t count = split ? light_stages().size() : 1;
   for (std::size_t i = 0; i < count; ++i) {
     auto stage = std::make_unique<Stage>();
     if (i == 0) {
@@ -126,17 +126,26 @@ Image Reconstruction::run_components(const Frame& frame, const ExecOptions& opti
                "filter '" + filter().info().name + "'" + (accumulate_ ? " with accumulation" : "") +
                    " with components=light_passes");
   const auto& comps = light_components();
-  std::vector<Image> filtered;
-  for (std::size_t i = 0; i < comps.size(); ++i) {
-    Frame part = component_frame(frame, comps[i], options.nthreads);
+  const auto& parts = light_stages();
+  std::vector<Image> filtered(comps.size());
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const LightStage& s = parts[i];
+    Frame part = component_frame(frame, comps[s.component], options.nthreads, s.part);
     const std::size_t before = notes_.size();
-    filtered.push_back(run_stage(*stages_[i], part, options));
-    for (std::size_t k = before; k < notes_.size(); ++k) notes_[k] = std::string(comps[i].name) + ": " + notes_[k];
-    for (const std::string& m : stages_[i]->filter->notes()) notes_.push_back(std::string(comps[i].name) + ": " + m);
+    Image light = run_stage(*stages_[i], part, options);
+    Image& sum = filtered[s.component];
+    if (sum.pixel_count() == 0)
+      sum = std::move(light);
+    else
+      add_light(sum, light, options.nthreads);
+    const std::string name = light_stage_name(s);
+    for (std::size_t k = before; k < notes_.size(); ++k) notes_[k] = name + ": " + notes_[k];
+    for (const std::string& m : stages_[i]->filter->notes()) notes_.push_back(name + ": " + m);
   }
   Recombined r = recombine(frame, filtered, options.nthreads);
-  notes_.push_back("components=light_passes: diffuse, glossy and transmission light (direct + indirect) filtered one "
-                   "by one and multiplied by their colour pass; emission and environment passed through");
+  notes_.push_back("components=light_passes: diffuse light (direct + indirect), glossy and transmission light (direct "
+                   "and indirect apart, then added) filtered one by one and multiplied by their colour pass; emission "
+                   "and environment passed through");
   if (components) *components = std::move(r.layers);
   return std::move(r.beauty);
 }

@@ -8,8 +8,9 @@
 // bmfr's phase I is (prepare/history_guards.h, defaults): fireflies are cut before they
 // enter the history, and mirror-like pixels keep none.
 //
-// With components=light_passes (pipeline/components.h) each light component runs through
-// its own accumulation and filter (one history per component); the filter's demodulation
+// With components=light_passes (pipeline/components.h) each light component (glossy and
+// transmission: its direct and its indirect light) runs through its own accumulation and
+// filter (one history per stage, light_stages()); the filter's demodulation
 // is turned off (the light passes are already demodulated) and the result is their
 // recombination.
 //
@@ -37,7 +38,7 @@ class Reconstruction {
 
   Filter& filter() { return *stages_.front()->filter; }
   const Filter& filter() const { return *stages_.front()->filter; }
-  // components=light_passes: one stage per light component.
+  // components=light_passes: one stage per light_stages() entry.
   bool light_passes() const { return stages_.size() > 1; }
   bool accumulates() const { return accumulate_; }
   // Frame order matters (history between run() calls): a temporal filter, or accumulation.
@@ -64,7 +65,7 @@ class Reconstruction {
   std::string parameters_text() const;
 
  private:
-  // One filter and its accumulation history: the beauty's, or one light component's.
+  // One filter and its accumulation history: the beauty's, or one light stage's.
   struct Stage {
     std::unique_ptr<Filter> filter;
     TemporalAccumulator accumulator;

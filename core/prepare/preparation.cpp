@@ -58,9 +58,10 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
 
 ParamSpec components_param() {
   return ParamSpec::Enum("components", "beauty", {"beauty", "light_passes"},
-                         "beauty = filter the Combined pass; light_passes = filter Blender's diffuse, glossy and "
-                         "transmission light (direct + indirect, already divided by their colour pass) one by one, "
-                         "multiply each by its colour pass, add emission and environment as they are");
+                         "beauty = filter the Combined pass; light_passes = filter Blender's diffuse light (direct + "
+                         "indirect) and glossy and transmission light (direct and indirect apart, added after "
+                         "filtering), already divided by their colour pass, one by one, multiply each by its colour "
+                         "pass, add emission and environment as they are");
 }
 
 namespace {

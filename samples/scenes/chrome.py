@@ -18,7 +18,9 @@ The camera dollies 0.75 m to the left and 0.2 m closer while panning the same wa
 (frames 1 and 16), linear interpolation and extrapolation, so every frame has motion vectors
 both ways and the lamp's highlights slide along the tap, kettle and toaster.
 
-No light passes (smaller files); the usual passes incl. DiffCol/GlossCol. Indirect clamp off.
+The noisy frames carry Blender's light passes (as `metal`'s: the held-out check of
+components=light_passes), besides the usual passes; the references are Combined only. Indirect
+clamp off.
 
     blender -b --factory-startup --python-exit-code 1 --python chrome.py -- --out DIR [--frames 1-16]
 """
@@ -179,4 +181,4 @@ def build():
 if __name__ == "__main__":
     args = C.parse_args("chrome", default_size=(192, 108), sequence=True)
     build()
-    C.render_jobs(args, "chrome", clamp_indirect=CLAMP_INDIRECT)
+    C.render_jobs(args, "chrome", clamp_indirect=CLAMP_INDIRECT, light_passes=True)

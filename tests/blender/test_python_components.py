@@ -43,7 +43,7 @@ def main():
         t = mcrecon.denoise_file(src, got, "atrous", {"components": "light_passes"}, keep_components=True)
         assert same_bits(tu.read_channels(got, CHANNELS), ref), "denoise_file differs from the CLI"
         assert any("components=light_passes" in n for n in t["notes"]), t["notes"]
-        assert any(n.startswith("glossy: ") for n in t["notes"]), t["notes"]
+        assert any(n.startswith("glossy direct: ") for n in t["notes"]), t["notes"]
 
         s = mcrecon.Session("atrous", {"components": "light_passes"})
         assert s.params["components"] == "light_passes" and s.params["demodulate"] is False, s.params

@@ -2,7 +2,8 @@
 with every Blender light pass (light_passes_testutil.py).
 
 Oracles: each component run alone through the CLI as an ordinary beauty (a file whose Combined is
-that component's direct + indirect light, with the same features), multiplied by its colour pass in
+that component's direct + indirect light, with the same features; glossy and transmission: its
+direct and its indirect light each alone, added after filtering), multiplied by its colour pass in
 numpy, plus Emit and Env, is the light_passes output; the written component layers add up to the
 written beauty within 1e-5 relative per pixel; a missing light pass is refused naming it and the
 file; --keep-components without light passes is refused.
@@ -52,14 +53,20 @@ class ComponentsCliTest(unittest.TestCase):
                 for n in lp.LAYERS:
                     total += layers[n]
                 np.testing.assert_array_less(np.abs(total - beauty), 1e-5 * np.abs(beauty) + 1e-30)
-                # Each component as the CLI filters an ordinary beauty, times its colour pass.
+                # Each component as the CLI filters an ordinary beauty, times its colour pass:
+                # diffuse light as direct + indirect, glossy and transmission light as direct
+                # and indirect apart, added after filtering.
                 expected = self.passes["Emit"] + self.passes["Env"]
                 for name, short in lp.COMPONENTS:
-                    light = self.passes[short + "Dir"] + self.passes[short + "Ind"]
-                    single = self.path("%s_%s.exr" % (filt, short))
-                    lp.write_single(single, light, self.passes, self.passes[short + "Col"])
-                    self.denoise("-f", filt, single, "-o", single + ".out.exr")
-                    want = tu.read_channels(single + ".out.exr", RGB) * self.passes[short + "Col"]
+                    parts = ([self.passes[short + "Dir"] + self.passes[short + "Ind"]] if short == "Diff"
+                             else [self.passes[short + "Dir"], self.passes[short + "Ind"]])
+                    light = np.zeros_like(parts[0])
+                    for i, part in enumerate(parts):
+                        single = self.path("%s_%s_%d.exr" % (filt, short, i))
+                        lp.write_single(single, part, self.passes, self.passes[short + "Col"])
+                        self.denoise("-f", filt, single, "-o", single + ".out.exr")
+                        light = light + tu.read_channels(single + ".out.exr", RGB)
+                    want = light * self.passes[short + "Col"]
                     np.testing.assert_allclose(layers[name], want, rtol=1e-6, atol=1e-7, err_msg=name)
                     expected = expected + want
                 np.testing.assert_array_equal(layers["Emission"], self.passes["Emit"])
@@ -110,7 +117,8 @@ class ComponentsCliTest(unittest.TestCase):
         proc = self.denoise("-f", "auto", "--set", "components=light_passes", "--keep-components", self.input,
                             "-o", out, "-v")
         self.assertIn("diffuse: auto:", proc.stderr)
-        self.assertIn("transmission: auto:", proc.stderr)
+        self.assertIn("glossy direct: auto:", proc.stderr)
+        self.assertIn("transmission indirect: auto:", proc.stderr)
 
 
 if __name__ == "__main__":

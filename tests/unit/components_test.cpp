@@ -4,6 +4,7 @@
 // frames the test builds; the sum of the layers recomputed here.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <vector>
@@ -68,14 +69,16 @@ Frame light_frame(int w, int h, unsigned seed) {
   return f;
 }
 
-// Component k of `f` as an ordinary frame, built here: colour = direct + indirect, albedo =
-// its colour pass, the other features.
-Frame alone(const Frame& f, int k) {
+// Component k of `f` as an ordinary frame, built here: colour = direct + indirect (only one
+// of them for `part`), albedo = its colour pass, the other features.
+Frame alone(const Frame& f, int k, LightPart part = LightPart::Both) {
   Frame g;
   g.width = f.width;
   g.height = f.height;
   g.path = f.path;
-  add_pass(g, Role::Colour, sum_of(f.image(kParts[k].direct), f.image(kParts[k].indirect)));
+  const Image& d = f.image(kParts[k].direct);
+  const Image& i = f.image(kParts[k].indirect);
+  add_pass(g, Role::Colour, part == LightPart::Direct ? d : part == LightPart::Indirect ? i : sum_of(d, i));
   add_pass(g, Role::Albedo, f.image(kParts[k].colour));
   for (Role r : {Role::Normal, Role::Position, Role::Motion}) add_pass(g, r, f.image(r));
   return g;
@@ -149,8 +152,9 @@ TEST(Components, EveryMissingLightPassIsNamedWithTheFile) {
   EXPECT_NO_THROW(reconstruction("box", {}, false)->run(f));
 }
 
-// One history per component: two frames through the split equal each component's own filter
-// run alone on the same two frames.
+// One history per stage: two frames through the split equal each stage's own filter run
+// alone on the same two frames (diffuse: direct + indirect; glossy and transmission: the
+// direct and the indirect light each alone, added after filtering).
 TEST(Components, TemporalHistoriesArePerComponent) {
   const Frame f1 = light_frame(24, 20, 11), f2 = light_frame(24, 20, 12);
   struct Case {
@@ -161,21 +165,63 @@ TEST(Components, TemporalHistoriesArePerComponent) {
   for (const Case& c : {Case{"bmfr", {{"block_size", "8"}, {"features", "with_albedo"}}, false}, Case{"box", {{"radius", "0"}, {"step_back", "false"}}, true}}) {
     SCOPED_TRACE(c.filter);
     auto split = reconstruction(c.filter, c.params, true, c.accumulate);
-    std::vector<std::unique_ptr<Reconstruction>> single;
+    // [k][0]: diffuse direct + indirect, else direct; [k][1]: indirect.
+    std::unique_ptr<Reconstruction> single[3][2];
     auto single_params = c.params;
     if (c.filter == "bmfr") single_params.push_back({"albedo_demodulation", "false"});
-    for (int k = 0; k < 3; ++k) single.push_back(reconstruction(c.filter, single_params, false, c.accumulate));
+    for (auto& k : single)
+      for (auto& p : k) p = reconstruction(c.filter, single_params, false, c.accumulate);
     std::vector<ComponentImage> layers;
     for (const Frame* f : {&f1, &f2}) {
       split->run(*f, {}, &layers);
       for (int k = 0; k < 3; ++k) {
-        const Image light = single[std::size_t(k)]->run(alone(*f, k));
+        Image light;
+        if (k == 0) {
+          light = single[k][0]->run(alone(*f, k));
+        } else {
+          light = single[k][0]->run(alone(*f, k, LightPart::Direct));
+          const Image indirect = single[k][1]->run(alone(*f, k, LightPart::Indirect));
+          for (std::size_t j = 0; j < light.storage().size(); ++j) light.storage()[j] += indirect.storage()[j];
+        }
         const Image& col = f->image(kParts[k].colour);
         for (std::size_t j = 0; j < col.storage().size(); ++j)
           ASSERT_EQ(layers[std::size_t(k)].rgb.storage()[j], light.storage()[j] * col.storage()[j]) << k << " " << j;
       }
     }
   }
+}
+
+// Diffuse light is filtered as direct + indirect, glossy and transmission light as direct and
+// indirect apart. Oracle: box with radius 0 and clamp=1 keeps min(v, 1) per channel, so
+// min(d + i, 1) (summed) and min(d, 1) + min(i, 1) (apart) differ where d + i > 1.
+TEST(Components, GlossyAndTransmissionDirectAndIndirectAreFilteredApart) {
+  const Frame f = light_frame(13, 9, 21);
+  auto rec = reconstruction("box", {{"radius", "0"}, {"step_back", "false"}, {"firefly_k", "0"}, {"clamp", "1"}}, true);
+  std::vector<ComponentImage> layers;
+  rec->run(f, {}, &layers);
+  auto clamp1 = [](float v) { return std::min(std::max(v, -1.0f), 1.0f); };
+  int apart_differs = 0;
+  for (int k = 0; k < 3; ++k) {
+    const Image& d = f.image(kParts[k].direct);
+    const Image& i = f.image(kParts[k].indirect);
+    const Image& col = f.image(kParts[k].colour);
+    for (std::size_t j = 0; j < col.storage().size(); ++j) {
+      const float dj = d.storage()[j], ij = i.storage()[j];
+      const float light = k == 0 ? clamp1(dj + ij) : clamp1(dj) + clamp1(ij);
+      ASSERT_EQ(layers[std::size_t(k)].rgb.storage()[j], light * col.storage()[j]) << k << " " << j;
+      apart_differs += k > 0 && clamp1(dj) + clamp1(ij) != clamp1(dj + ij);
+    }
+  }
+  EXPECT_GT(apart_differs, 10);  // the frame does tell the two apart
+  // The notes name the stage they come from.
+  std::string notes;
+  for (const std::string& n : rec->notes()) notes += n + "\n";
+  EXPECT_NE(notes.find("direct and indirect apart"), std::string::npos) << notes;
+  std::vector<std::string> names;
+  for (const LightStage& s : light_stages()) names.push_back(light_stage_name(s));
+  const std::vector<std::string> want = {"diffuse", "glossy direct", "glossy indirect", "transmission direct",
+                                         "transmission indirect"};
+  EXPECT_EQ(names, want);
 }
 
 TEST(Components, ComponentFrameCarriesFeaturesItsColourAsAlbedoNotTheBeautysVariance) {
@@ -188,6 +234,12 @@ TEST(Components, ComponentFrameCarriesFeaturesItsColourAsAlbedoNotTheBeautysVari
   // The colour passes go along (bmfr tells mirrors by them); the other light passes do not.
   EXPECT_TRUE(g.has(Role::GlossyColour) && g.has(Role::DiffuseColour));
   EXPECT_FALSE(g.has(Role::GlossyDirect) || g.has(Role::DiffuseDirect) || g.has(Role::Emission));
+  // A part alone: its light only, the same features.
+  const Frame d = component_frame(f, light_components()[1], 1, LightPart::Direct);
+  const Frame i = component_frame(f, light_components()[1], 1, LightPart::Indirect);
+  EXPECT_EQ(d.image(Role::Colour).storage(), f.image(Role::GlossyDirect).storage());
+  EXPECT_EQ(i.image(Role::Colour).storage(), f.image(Role::GlossyIndirect).storage());
+  EXPECT_EQ(i.image(Role::Albedo).storage(), f.image(Role::GlossyColour).storage());
 }
 
 TEST(Components, NothingNonFiniteLeavesTheRecombination) {
