@@ -73,7 +73,12 @@ const FilterInfo& BmfrFilter::static_info() {
                          "I and III; their phase I history is also cut to the brightest of the current 3x3 neighbourhood"),
         ParamSpec::Enum("features", "default", {"default", "first_order", "with_albedo", "with_depth"},
                         "feature set: default [1,n,w,w^2] (10), first_order [1,n,w] (7), with_albedo (+albedo, 13), "
-                        "with_depth (+depth, 11)"),
+                        "with_depth (+depth, 11); each but with_albedo + the albedo luminance (albedo_luminance)"),
+        ParamSpec::Bool("albedo_luminance", true,
+                        "fit also against the albedo's luminance (one more column; when an albedo pass exists and "
+                        "features is not with_albedo): a surface with a specular layer (glossy tiles, a varnished "
+                        "checker floor) keeps its texture after the demodulation (its specular light divided by the "
+                        "albedo), which the smooth features blur across texture edges"),
         ParamSpec::Bool("offsets", true, "displace the block grid every frame by a fixed 16-entry random sequence"),
         ParamSpec::Bool("taa", true, "temporal anti-aliasing (reprojected history clipped to the 3x3 neighbourhood, see taa_clip) at the end"),
         ParamSpec::Float("taa_alpha", 0.2, 0.01, 1.0, "TAA: weight of the current frame"),
@@ -134,6 +139,7 @@ std::vector<std::string> BmfrFilter::own_unused() const {
   for (const char* name : {"taa_alpha", "taa_clip", "taa_gamma", "taa_history"}) unused_when(!taa, name, "with taa=false", u);
   unused_when(taa && params_.get_enum("taa_clip") != "ycocg_variance", "taa_gamma", "with taa_clip=rgb_minmax", u);
   unused_when(!params_.get_bool("albedo_demodulation"), "albedo_floor", "with albedo_demodulation=false", u);
+  unused_when(params_.get_enum("features") == "with_albedo", "albedo_luminance", "with features=with_albedo", u);
   for (const char* name : {"sample_limit_radius", "sample_limit_history"})
     unused_when(!(params_.get_float("sample_limit_k") > 0), name, "with sample_limit_k=0", u);
   return u;

@@ -29,6 +29,10 @@ namespace mcr {
 // pixels at a time (temporal/*_avx2, bmfr_taa, bmfr_fit, bmfr_fit_features); they do the
 // float operations of the scalar loops in the same order without FMA, so both builds give
 // the same bits.
+// Texture edges (issue 15): colour = albedo x light + specular on a surface with a specular
+// layer, so the demodulated illumination keeps the texture (specular / albedo); the fit
+// also regresses on the albedo's luminance (albedo_luminance, one column), which follows
+// it where the smooth features would blur it across the edge (bmfr_fit.cpp).
 // Highlights and mirrors (issue 15; prepare/surface_classes.h, temporal/accumulation.h):
 //   - phase I's new sample is cut to its neighbours' mean + sample_limit_k deviations
 //     unless its own history backs it (a firefly does not enter the history);

@@ -153,9 +153,11 @@ MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
     const float* vrow = valid + rb;
     int x = 0;
 #ifdef MCR_FIT_GATHER_AVX2
-    if (!alb && !dep && pch == 3 && nch == 3 && isa_at_least(Isa::Avx2)) {
+    if ((!alb || (lay.albedo_luminance && alb->channels() == 3)) && !dep && pch == 3 && nch == 3 &&
+        isa_at_least(Isa::Avx2)) {
       x = bw / 8 * 8;
-      W = gather_row_avx2(nrow, prow, irow, vrow, x, p, snp, raw, fin, zp, rows, W);
+      W = gather_row_avx2(nrow, prow, alb ? alb->data() + rb * 3 : nullptr, irow, vrow, x, p, snp, raw, fin, zp, rows,
+                          W);
       p += x;
     }
 #endif
@@ -171,10 +173,17 @@ MCR_ALWAYS_INLINE void fit_block_body(const FitJob& J, FitScratch& S, int b) {
       int k = 6;
       if (alb) {
         const float* a = alb->pixel(x0 + x, y);
-        for (int c = 0; c < 3; ++c, ++k) {
-          const float t = a[std::min(c, alb->channels() - 1)];
-          raw[std::size_t(k) * snp + std::size_t(p)] = t;
+        const int ac = alb->channels() - 1;
+        if (lay.albedo_luminance) {
+          const float t = albedo_luminance(a[0], a[std::min(1, ac)], a[std::min(2, ac)]);
+          raw[std::size_t(k++) * snp + std::size_t(p)] = t;
           f += t - t;
+        } else {
+          for (int c = 0; c < 3; ++c, ++k) {
+            const float t = a[std::min(c, ac)];
+            raw[std::size_t(k) * snp + std::size_t(p)] = t;
+            f += t - t;
+          }
         }
       }
       if (dep) {
@@ -408,12 +417,13 @@ void BmfrFilter::fit_blocks(const Frame& frame, const Image& illum, const std::v
   const int w = frame.width, h = frame.height;
   const int B = block_side(params_.get_int("block_size"), w, h);
   FeatureLayout lay = layout_of(params_.get_enum("features"));
+  lay.albedo_luminance = !lay.albedo && params_.get_bool("albedo_luminance") && frame.find(Role::Albedo);
   const double eps = params_.get_float("epsilon");
   const std::uint64_t seed = std::uint64_t(params_.get_int("seed"));
   const bool clamp_max = params_.get_bool("fit_clamp");
   const Image& pos = frame.image(Role::Position, Prefer::Geometry);
   const Image& nrm = frame.image(Role::Normal, Prefer::Geometry);
-  const Image* alb = lay.albedo ? &frame.image(Role::Albedo) : nullptr;
+  const Image* alb = lay.albedo || lay.albedo_luminance ? &frame.image(Role::Albedo) : nullptr;
   const Image* dep = lay.depth ? &frame.image(Role::Depth) : nullptr;
   std::vector<std::string> skipped;
   lay.dropped = constant_columns(lay, nrm, pos, alb, dep, nthreads, skipped);

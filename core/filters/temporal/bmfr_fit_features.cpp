@@ -24,17 +24,22 @@ unsigned constant_columns(const FeatureLayout& lay, const Image& nrm, const Imag
   struct Src {
     const Image* im;
     const char* name;
-    int raw0, channels;
+    int raw0, channels, columns;  // channels tested, raw columns they feed
   };
-  const Src srcs[4] = {{&nrm, "normal", 0, 3}, {&pos, "position", 3, 3}, {alb, "albedo", 6, 3},
-                       {dep, "depth", lay.albedo ? 9 : 6, 1}};
+  const int albedo_columns = lay.albedo ? 3 : lay.albedo_luminance ? 1 : 0;
+  const Src srcs[4] = {{&nrm, "normal", 0, 3, 3},
+                       {&pos, "position", 3, 3, 3},
+                       {albedo_columns ? alb : nullptr, lay.albedo ? "albedo" : "albedo (its luminance)", 6, 3,
+                        albedo_columns},
+                       {dep, "depth", 6 + albedo_columns, 1, 1}};
   unsigned drop = 0;
   for (const Src& s : srcs) {
     if (!s.im) continue;
     const Roi all = Roi::all(s.im->width(), s.im->height());
-    const FeatureActivity a = feature_activity(*s.im, s.channels, all, Tolerance(0.0, 0.49e-5), nthreads);
+    const FeatureActivity a =
+        feature_activity(*s.im, std::min(s.channels, s.im->channels()), all, Tolerance(0.0, 0.49e-5), nthreads);
     if (a.kind != Activity::Constant) continue;
-    for (int c = 0; c < s.channels; ++c) drop |= 1u << lay.column_of_raw(s.raw0 + c);
+    for (int c = 0; c < s.columns; ++c) drop |= 1u << lay.column_of_raw(s.raw0 + c);
     if (s.raw0 == 3 && lay.squares) drop |= 7u << 7;  // the squares of a constant position
     notes.push_back(activity_note(s.name, a, all, all.width(), all.height(), "left out of the regression"));
   }
@@ -90,17 +95,25 @@ void scale_masked(const float* src, const float* mask, int np, float lo, float s
 }
 
 #ifdef MCR_FIT_GATHER_AVX2
-__attribute__((target("avx2"))) int gather_row_avx2(const float* nrow, const float* prow, const float* irow,
-                                                     const float* vrow, int n8, int p, std::size_t snp, float* raw,
-                                                     float* fin, float* zp, int* rows, int W) {
+__attribute__((target("avx2"))) int gather_row_avx2(const float* nrow, const float* prow, const float* arow,
+                                                     const float* irow, const float* vrow, int n8, int p,
+                                                     std::size_t snp, float* raw, float* fin, float* zp, int* rows,
+                                                     int W) {
   const __m256 zero = _mm256_setzero_ps(), one = _mm256_set1_ps(1.0f);
+  const __m256 k0 = _mm256_set1_ps(0.2126f), k1 = _mm256_set1_ps(0.7152f), k2 = _mm256_set1_ps(0.0722f);
+  const int nraw = arow ? 7 : 6;
   for (int x = 0; x < n8; x += 8, p += 8) {
-    __m256 v[6], z[3];
+    __m256 v[7], z[3];
     load_rgb8(nrow + std::size_t(x) * 3, v[0], v[1], v[2]);
     load_rgb8(prow + std::size_t(x) * 3, v[3], v[4], v[5]);
     load_rgb8(irow + std::size_t(x) * 3, z[0], z[1], z[2]);
-    __m256 f = zero;  // 0 where all six are finite, NaN otherwise
-    for (int c = 0; c < 6; ++c) {
+    if (arow) {  // albedo_luminance(): (k0 r + k1 g) + k2 b, no FMA
+      __m256 a[3];
+      load_rgb8(arow + std::size_t(x) * 3, a[0], a[1], a[2]);
+      v[6] = _mm256_add_ps(_mm256_add_ps(_mm256_mul_ps(k0, a[0]), _mm256_mul_ps(k1, a[1])), _mm256_mul_ps(k2, a[2]));
+    }
+    __m256 f = zero;  // 0 where all features are finite, NaN otherwise
+    for (int c = 0; c < nraw; ++c) {
       _mm256_storeu_ps(raw + std::size_t(c) * snp + std::size_t(p), v[c]);
       f = _mm256_add_ps(f, _mm256_sub_ps(v[c], v[c]));
     }
