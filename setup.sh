@@ -18,7 +18,7 @@ PACKAGES=(
   libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
   libgtest-dev libbenchmark-dev
   pybind11-dev python3-pybind11 python3-numpy
-  blender
+  blender xvfb xauth
   clang libclang-rt-14-dev libfuzzer-14-dev llvm-14
 )
 

@@ -1,0 +1,92 @@
+"""Runs inside Blender WITH a window (under Xvfb) for tests/blender/test_gui.py:
+
+    blender --factory-startup --python gui_smoke.py -- SCENE.blend OUT_DIR   (the scene opened first)
+
+Turns the 3D viewport into a Properties editor on the Render tab, enables the add-on on the
+sample room with bilateral, opens the Features sub-panel, renders with F12 (INVOKE, the render
+window), waits for the denoised result, takes screenshots (the panel; the render window) and
+writes OUT_DIR/gui.json with what it saw; then quits."""
+import json
+import os
+import sys
+
+import addon_utils
+import bpy
+
+OUT = sys.argv[sys.argv.index("--") + 2]
+state = {"step": 0, "waited": 0.0}
+result = {}
+
+
+def area_of(kind):
+    """The largest area of that type, with its window."""
+    found = [(a.width * a.height, w, a) for w in bpy.context.window_manager.windows
+             for a in w.screen.areas if a.type == kind]
+    if not found:
+        return None, None
+    _, window, area = max(found, key=lambda t: t[0])
+    return window, area
+
+
+def finish():
+    with open(os.path.join(OUT, "gui.json"), "w") as f:
+        json.dump(result, f, indent=1)
+    bpy.ops.wm.quit_blender()
+
+
+def tick():
+    try:
+        return step()
+    except Exception as e:  # any failure ends the run with the reason recorded
+        import traceback
+        result["error"] = f"{type(e).__name__}: {e}\n{traceback.format_exc()}"
+        finish()
+        return None
+
+
+def step():
+    scene = bpy.context.scene
+    if state["step"] == 0:
+        sys.path.insert(0, os.environ["MCRECON_ADDON_STAGE"])
+        addon_utils.enable("mcrecon_addon", default_set=True, handle_error=None)
+        window, area = area_of("VIEW_3D")
+        area.type = "PROPERTIES"  # its tabs exist after a redraw: the next step picks Render
+        scene.mcrecon.enabled = True
+        scene.mcrecon.filter = "bilateral"
+        state["step"] = 1
+        return 1.0
+    if state["step"] == 1:
+        for window in bpy.context.window_manager.windows:
+            for area in window.screen.areas:
+                if area.type == "PROPERTIES":
+                    area.spaces.active.context = "RENDER"
+        state["step"] = 10
+        return 1.0
+    if state["step"] == 10:
+        window, area = area_of("PROPERTIES")
+        with bpy.context.temp_override(window=window, area=area):
+            bpy.ops.screen.screenshot_area(filepath=os.path.join(OUT, "panel.png"))
+        result["panel_png"] = os.path.join(OUT, "panel.png")
+        result["passes_in_use"] = __import__("mcrecon_addon.passes", fromlist=["x"]).in_use(scene)
+        with bpy.context.temp_override(window=window, area=area):
+            bpy.ops.render.render("INVOKE_DEFAULT", write_still=False)
+        state["step"] = 2
+        return 1.0
+    if state["step"] == 2:
+        img = bpy.data.images.get("mcrecon Result")
+        if (img is None or img.packed_file is None) and state["waited"] < 90:
+            state["waited"] += 1.0
+            return 1.0
+        result["result_packed"] = img is not None and img.packed_file is not None
+        result["message"] = scene.mcrecon.last_message
+        window, area = area_of("IMAGE_EDITOR")
+        result["render_window_shows"] = area.spaces.active.image.name if area and area.spaces.active.image else None
+        if window is not None:
+            with bpy.context.temp_override(window=window, area=area):
+                bpy.ops.screen.screenshot(filepath=os.path.join(OUT, "render_window.png"))
+        result["files_written"] = sorted(os.listdir(OUT))
+        finish()
+        return None
+
+
+bpy.app.timers.register(tick, first_interval=2.0)

@@ -1,0 +1,54 @@
+"""Issue 16's GUI smoke test (ctest blender_addon_gui): Blender with a window under Xvfb opens
+the sample room, shows the add-on's panel on the Render tab, renders with F12 and shows the
+denoised result in the render window; the panel's screenshot is kept for the README
+(OUT/panel.png). Skipped (exit 77) with a message where xvfb-run is absent; setup.sh installs it.
+Environment: MCRECON_BLENDER, MCRECON_SOURCE_DIR, MCRECON_ADDON_STAGE, MCRECON_TEST_TMP."""
+import json
+import os
+import shutil
+import subprocess
+import sys
+
+import OpenImageIO as oiio
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+OUT = os.path.join(os.environ["MCRECON_TEST_TMP"], "gui")
+BLENDER = os.environ["MCRECON_BLENDER"]
+
+if not shutil.which("xvfb-run"):
+    print("SKIPPED: xvfb-run is not installed (apt-get install xvfb; setup.sh test installs it)")
+    sys.exit(77)
+shutil.rmtree(OUT, ignore_errors=True)
+os.makedirs(OUT)
+env = dict(os.environ, BLENDER_USER_CONFIG=os.path.join(OUT, "config"),
+           BLENDER_USER_SCRIPTS=os.path.join(OUT, "scripts"))
+# The scene, saved headless: opening a file skips the splash screen.
+blend = os.path.join(OUT, "room.blend")
+build = ("import sys, os, bpy; sys.path.insert(0, os.path.join(os.environ['MCRECON_SOURCE_DIR'], 'samples', "
+         "'scenes')); import common as C, room; s = room.build(); C.configure_render(s, 320, 240); "
+         "s.cycles.samples = 4; s.render.image_settings.file_format = 'PNG'; s.render.filepath = os.path.join(%r, 'render'); "
+         "bpy.ops.wm.save_as_mainfile(filepath=%r)" % (OUT, blend))
+p = subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", build],
+                   capture_output=True, text=True, timeout=120, env=env)
+assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
+p = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x2000x24", BLENDER, "--factory-startup", blend,
+                    "--python", os.path.join(HERE, "gui_smoke.py"), "--", blend, OUT],
+                   capture_output=True, text=True, timeout=240, env=env)
+log = p.stdout + p.stderr
+with open(os.path.join(OUT, "blender.log"), "w") as f:
+    f.write(log)
+assert os.path.exists(os.path.join(OUT, "gui.json")), "Blender wrote no result:\n" + log[-4000:]
+with open(os.path.join(OUT, "gui.json")) as f:
+    r = json.load(f)
+assert "error" not in r, r["error"]
+assert "Traceback" not in log, log[-4000:]
+panel = oiio.ImageBuf(r["panel_png"])
+assert panel.spec().width > 300 and panel.spec().height > 300, (panel.spec().width, panel.spec().height)
+assert r["result_packed"], "no denoised result after F12: " + r.get("message", "")
+assert "ERROR" not in r["message"], r["message"]
+assert r["render_window_shows"] == "mcrecon Result", r["render_window_shows"]
+assert [f for f in r["files_written"] if "denoised" in f] == [], f"F12 wrote files: {r['files_written']}"
+assert "Normal" in r["passes_in_use"] and "Albedo" in r["passes_in_use"], r["passes_in_use"]
+print(f"gui: panel screenshot {panel.spec().width}x{panel.spec().height} ({r['panel_png']}); F12 showed "
+      f"'mcrecon Result' in the render window; passes in use: {', '.join(r['passes_in_use'])}")
+print("OK")
