@@ -165,6 +165,32 @@ class MCRECON_OT_apply_passes(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class MCRECON_OT_render(bpy.types.Operator):
+    """Render, denoise, and with Denoise Before Compositing run the compositor on the denoised image (for scripts: a render handler cannot start the compositor pass)"""
+    bl_idname = "mcrecon.render"
+    bl_label = "Render Denoised"
+    bl_options = {"REGISTER"}
+
+    animation: bpy.props.BoolProperty(name="Animation", default=False)
+    write_still: bpy.props.BoolProperty(name="Write Still", default=True)
+
+    def execute(self, context):
+        from . import composite, render_hooks
+        scene = context.scene
+        composite.state["operator"] = True
+        try:
+            if self.animation:
+                bpy.ops.render.render(animation=True)
+            else:
+                bpy.ops.render.render(write_still=self.write_still)
+            outputs = render_hooks.finish_composites(scene)
+        finally:
+            composite.state["operator"] = False
+        for o in outputs:
+            self.report({"INFO"}, f"mcrecon: {o}")
+        return {"FINISHED"}
+
+
 class MCRECON_OT_restore_scene(bpy.types.Operator):
     """Put back every scene setting mcrecon changed (passes, Cycles denoising, compositing) and remove the nodes it added"""
     bl_idname = "mcrecon.restore_scene"
@@ -191,7 +217,7 @@ class MCRECON_OT_report(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
+_classes = (MCRECON_OT_render, MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
 
 
 def register():

@@ -154,6 +154,11 @@ def _base_annotations():
             description="With Denoise light passes: write each denoised component as its own layer of the output "
                         "(<layer>.Denoised.Diffuse, Glossy, Transmission, Emission, Environment), summing to "
                         "the beauty (mcrecon denoise --keep-components)"),
+        "before_compositing": bpy.props.BoolProperty(
+            name="Denoise Before Compositing", default=True,
+            description="With compositing on: denoise the raw render, then run your compositor nodes on the "
+                        "denoised image (grade and glare apply to it, as Blender's Denoise node placed right after "
+                        "Render Layers would); off: denoise the compositor's output"),
         "extra_params": bpy.props.StringProperty(
             name="Extra Parameters", default="", update=_on_filter_change,
             description="Advanced: KEY=VALUE pairs passed to the filter as they are (like mcrecon denoise --set)"),

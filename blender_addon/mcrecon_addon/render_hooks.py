@@ -20,11 +20,11 @@ import os
 import bpy
 from bpy.app.handlers import persistent
 
-from . import native, pass_output, properties
+from . import composite, native, pass_output, properties, status
 from .output_paths import EXTENSIONS, frame_path, output_for_frame  # noqa: F401 (frame_path: operators)
 
 RESULT_IMAGE = "mcrecon Result"
-_job = {"session": None, "key": None, "next": None}  # next: the frame that continues the history
+_job = {"session": None, "key": None, "next": None, "warned_before": False, "written": False}  # next: the frame that continues the history
 # Temp results: path -> {"packed": shown and packed, "released": no longer needed for the output}.
 _temps = {}
 
@@ -133,6 +133,32 @@ def _compositing(scene):
                 and any(n.bl_idname == "CompositorNodeComposite" for n in tree.nodes))
 
 
+def _grading(scene):
+    """The compositor changes the image: its Composite node is fed by something other than a
+    Render Layers node's Image (the add-on's own pass-file node and a Viewer change nothing)."""
+    comp = next((n for n in scene.node_tree.nodes if n.bl_idname == "CompositorNodeComposite"), None)
+    if comp is None or not comp.inputs["Image"].is_linked:
+        return False
+    link = comp.inputs["Image"].links[0]
+    return not (link.from_node.bl_idname == "CompositorNodeRLayers" and link.from_socket.name == "Image")
+
+
+def before_compositing(scene):
+    """Denoise the raw Combined, then run the user's compositor on it (composite.py). A plain
+    command-line render (blender -b -f/-a) cannot run the compositor pass after its own job, so
+    it denoises the composite instead and says so once; bpy.ops.mcrecon.render does it right."""
+    if not (scene.mcrecon.before_compositing and _compositing(scene) and _grading(scene)):
+        return False
+    if bpy.app.background and not composite.state["operator"]:
+        if not _job.get("warned_before"):
+            _job["warned_before"] = True
+            log(scene, "Denoise Before Compositing needs bpy.ops.mcrecon.render() in a command-line render "
+                       "(blender -b file.blend --python-expr \"import bpy; bpy.ops.mcrecon.render(animation=True)\"); "
+                       "this render denoises the compositor's output")
+        return False
+    return True
+
+
 def _session(scene):
     """The job's Session, made on the first frame (parameter errors surface here)."""
     mc = native.get()
@@ -144,9 +170,10 @@ def _session(scene):
     return _job["session"]
 
 
-def _show_result(path):
+def _show_result(path, now=False):
     """Loads `path` as the image "mcrecon Result", packed into the .blend with a fake user (kept
-    when the file is saved), and shows it in image editors that show the render."""
+    when the file is saved), and shows it in image editors that show the render. now: the
+    caller is in the main loop already."""
     def load():
         img = bpy.data.images.get(RESULT_IMAGE)
         if img is not None:
@@ -168,7 +195,7 @@ def _show_result(path):
                         space.image = img
         _settle(path, packed=True)
         return None
-    if bpy.app.background:
+    if bpy.app.background or now:
         load()
     else:  # handlers run in the render thread: touch bpy.data from the main loop
         bpy.app.timers.register(load, first_interval=0.0)
@@ -190,8 +217,10 @@ def denoise_render(scene, source, out, render_path):
         display = None if out.lower().endswith(".exr") else display_settings(scene)
         layer = pass_output.view_layer(scene).name
         passes = {}
-        if _compositing(scene):
+        if _compositing(scene) and not before_compositing(scene):  # "after compositing", by choice
             passes = {"colour": "Composite.Combined"}
+        status.show(f"mcrecon: denoising frame {frame} with {session.filter}"
+                    f"{' (accumulated)' if session.accumulate else ''}...")
         try:
             t = session.denoise_file(source, out, layer=layer, passes=passes,
                                      keep_components=scene.mcrecon.keep_components, display=display)
@@ -202,12 +231,14 @@ def denoise_render(scene, source, out, render_path):
             t = session.denoise_file(source, out, layer=layer, keep_components=scene.mcrecon.keep_components,
                                      display=display)
         _job["next"] = frame + 1
+        status.show(f"mcrecon: frame {frame} denoised in {t['total_ms'] / 1000:.1f} s ({session.filter})")
         log(scene, f"{session.filter}{' (accumulated)' if session.accumulate else ''} frame {frame}: {out} "
                    f"({t['filter_ms']:.0f} ms filter, {t['total_ms']:.0f} ms total)")
         for note in session.notes():
             log(scene, note)
         return out
     except mc.Error as e:
+        status.show(f"mcrecon: frame {scene.frame_current} not denoised (see the Info editor)")
         log(scene, f"{e} [{e.kind}]; the render itself is not affected ('{render_path}')", error=True)
     except Exception as e:  # never let the add-on break a render
         log(scene, f"{type(e).__name__}: {e}", error=True)
@@ -216,16 +247,25 @@ def denoise_render(scene, source, out, render_path):
 
 @persistent
 def on_render_init(scene, *args):
-    _job.update(session=None, key=None, next=None)
+    if composite.state["running"]:
+        return
+    _job.update(session=None, key=None, next=None, warned_before=False, written=False)
     if getattr(scene, "mcrecon", None) is not None:
         pass_output.ensure(scene)  # background / main thread; the UI sets it up on filter change
 
 
 @persistent
 def on_render_post(scene, *args):
+    if composite.state["running"]:
+        return
     # Not MultiLayer output (or F12 without a file): denoise the add-on's own pass file into a
     # temp result; render_write makes the user's output of it when the render is written.
-    if not getattr(scene, "mcrecon", None) or not pass_output.needed(scene):
+    if not getattr(scene, "mcrecon", None):
+        return
+    if not pass_output.needed(scene):
+        stale = pass_output.file_for(scene, scene.frame_current)
+        if stale:  # the node outlived a switch to MultiLayer (it goes at the next UI change)
+            _remove(stale)
         return
     frame = scene.frame_current
     source = pass_output.file_for(scene, frame)
@@ -234,20 +274,43 @@ def on_render_post(scene, *args):
                    "press 'Set Passes for Filter' (or choose the filter again) before rendering", error=True)
         return
     tmp = temp_result(scene, frame)
+    before = before_compositing(scene)
     try:
         out = denoise_render(scene, source, tmp, scene.render.frame_path(frame=frame))
     finally:
-        _remove(source)  # the pass file is ours: never left in the temp folder
-    if out is not None:
-        _temps[tmp] = {"packed": False, "released": False}
-        _show_result(tmp)
+        if not before or out is None:
+            _remove(source)  # the pass file is ours: never left in the temp folder
+    if out is None:
+        return
+    if before:  # the compositor runs on it after the job; render_write names the output
+        composite.queue({"frame": frame, "denoised": tmp, "passes": source, "output": None,
+                         "layer": pass_output.view_layer(scene).name, "temps": [tmp, source]})
+        return
+    _temps[tmp] = {"packed": False, "released": False}
+    _show_result(tmp)
 
 
 @persistent
 def on_render_write(scene, *args):
     if not getattr(scene, "mcrecon", None) or not scene.mcrecon.enabled:
         return
+    if composite.state["running"]:
+        return
+    _job["written"] = True
     path = written_path(scene)
+    if before_compositing(scene):
+        out = output_for(scene, path)
+        queued = [j for j in composite.pending() if j["frame"] == scene.frame_current]
+        if queued:  # denoised in render_post from the pass file
+            queued[-1]["output"] = out
+            return
+        if pass_output.needed(scene):
+            return  # denoising failed in render_post (logged there)
+        tmp = temp_result(scene, scene.frame_current)
+        if denoise_render(scene, path, tmp, path) is not None:
+            composite.queue({"frame": scene.frame_current, "denoised": tmp, "passes": path, "output": out,
+                             "layer": pass_output.view_layer(scene).name, "temps": [tmp]})
+        return
     if pass_output.needed(scene):
         tmp = temp_result(scene, scene.frame_current)
         if tmp not in _temps:
@@ -267,11 +330,77 @@ def on_render_write(scene, *args):
         _show_result(out)
 
 
-@persistent
-def on_render_complete(scene, *args):
+def finish_composites(scene):
+    """Runs the queued composites (denoise before compositing) and shows the last; an F12 frame
+    goes through a temp file in the render's format, packed as "mcrecon Result", then deleted."""
+    def shown_path(frame):
+        path = os.path.splitext(temp_result(scene, frame))[0] + "_composite" + scene.render.file_extension
+        _temps[path] = {"packed": False, "released": True}
+        return path
+    return composite.finish(scene, log=lambda m, error=False: log(scene, m, error=error),
+                            show=lambda p: _show_result(p, now=True), shown_path=shown_path)
+
+
+def _denoise_shown_render():
+    """F12 with an OpenEXR MultiLayer output writes no file, so render_write never sees the
+    passes: the Render Result (which holds them in the UI) is saved to a temp MultiLayer EXR,
+    denoised, shown as "mcrecon Result", and the temp files deleted. From a timer (main loop)."""
+    scene = bpy.context.scene
+    img = bpy.data.images.get("Render Result")
+    if img is None or not scene.mcrecon.enabled:
+        return None
+    frame = scene.frame_current
+    tmp = temp_result(scene, frame)
+    source = os.path.splitext(tmp)[0] + "_render.exr"
+    try:
+        img.save_render(source, scene=scene)  # the scene's format: every pass of the render
+    except Exception as e:
+        log(scene, f"could not read the F12 render's passes: {type(e).__name__}: {e}", error=True)
+        return None
+    before = before_compositing(scene)
+    out = denoise_render(scene, source, tmp, "F12 render (not written)")
     _job.update(session=None, key=None, next=None)
+    status.show(None)
+    if out is None:
+        _remove(source)
+        return None
+    if before:
+        composite.queue({"frame": frame, "denoised": tmp, "passes": source, "output": None,
+                         "layer": pass_output.view_layer(scene).name, "temps": [tmp, source]})
+        finish_composites(scene)
+        return None
+    _remove(source)
+    _temps[tmp] = {"packed": False, "released": True}
+    _show_result(tmp)
+    return None
+
+
+@persistent
+def on_render_cancel(scene, *args):
+    on_render_complete(scene, cancelled=True)
+
+
+@persistent
+def on_render_complete(scene, *args, cancelled=False):
+    if composite.state["running"]:
+        return
+    f12_multilayer = (not cancelled and not bpy.app.background and not _job["written"]
+                      and getattr(scene, "mcrecon", None) is not None and scene.mcrecon.enabled
+                      and not pass_output.needed(scene))
+    _job.update(session=None, key=None, next=None)
+    status.show(None)
     for tmp in list(_temps):
         _settle(tmp, released=True)
+    if composite.pending() and not composite.state["operator"]:
+        if bpy.app.background:  # not reached (before_compositing is off there): never leave temps
+            composite.discard()
+        else:
+            def later():
+                finish_composites(bpy.context.scene)
+                return None
+            bpy.app.timers.register(later, first_interval=0.1)
+    if f12_multilayer:
+        bpy.app.timers.register(_denoise_shown_render, first_interval=0.1)
 
 
 _handlers = (
@@ -279,7 +408,7 @@ _handlers = (
     (bpy.app.handlers.render_post, on_render_post),
     (bpy.app.handlers.render_write, on_render_write),
     (bpy.app.handlers.render_complete, on_render_complete),
-    (bpy.app.handlers.render_cancel, on_render_complete),
+    (bpy.app.handlers.render_cancel, on_render_cancel),
 )
 
 

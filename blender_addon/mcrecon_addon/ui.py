@@ -70,6 +70,7 @@ class MCRECON_PT_render(bpy.types.Panel):
         layout.prop(mc, "light_passes")
         if mc.light_passes:
             layout.prop(mc, "keep_components")
+        layout.prop(mc, "before_compositing")
         layout.prop(mc, "output_path")
         _label_lines(layout, "Passes in use: " + ", ".join(passes.in_use(context.scene)), icon="RENDERLAYERS")
         row = layout.row()

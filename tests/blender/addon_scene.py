@@ -287,6 +287,7 @@ def case_composite():
     mc = scene.mcrecon
     mc.enabled = True
     mc.filter = "box"
+    mc.before_compositing = False  # denoise the compositor's output, by choice
     scene.use_nodes = True
     scene.render.use_compositing = True
     tree = scene.node_tree
@@ -395,6 +396,77 @@ def case_denoise_files():
     result["seq"] = seq
 
 
+def case_composite_before():
+    """Issue 16 point 1: Glare and a colour grade after Render Layers apply to the denoised image."""
+    import subprocess
+    scene = room_scene()
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    scene.render.image_settings.color_depth = "32"
+    scene.use_nodes = True
+    scene.render.use_compositing = True
+    tree = scene.node_tree
+    for n in list(tree.nodes):
+        tree.nodes.remove(n)
+    rl = tree.nodes.new("CompositorNodeRLayers")
+    glare = tree.nodes.new("CompositorNodeGlare")
+    glare.glare_type, glare.threshold, glare.quality = "FOG_GLOW", 0.5, "HIGH"
+    grade = tree.nodes.new("CompositorNodeColorBalance")
+    grade.correction_method = "LIFT_GAMMA_GAIN"
+    grade.gain = (1.3, 1.0, 0.8)
+    grade.gamma = (1.1, 1.0, 0.9)
+    comp = tree.nodes.new("CompositorNodeComposite")
+    tree.links.new(rl.outputs["Image"], glare.inputs["Image"])
+    tree.links.new(glare.outputs["Image"], grade.inputs["Image"])
+    tree.links.new(grade.outputs["Image"], comp.inputs["Image"])
+    mc = scene.mcrecon
+    mc.enabled = True
+    mc.filter = "box"
+    scene.cycles.samples, scene.cycles.seed = 4, 9
+    scene.render.filepath = os.path.join(OUT, "comp")
+    result["operator"] = sorted(bpy.ops.mcrecon.render(write_still=True))
+    result["still"] = os.path.join(OUT, "comp.exr")
+    result["still_denoised"] = os.path.join(OUT, "comp_denoised.exr")
+    result["message"] = mc.last_message
+    result["temp_left"] = sorted(f for f in os.listdir(bpy.app.tempdir) if f.startswith("mcrecon"))
+    # An animation of 3 frames: frame 1 is the still above.
+    scene.frame_start, scene.frame_end = 1, 3
+    scene.render.filepath = os.path.join(OUT, "anim_####")
+    result["anim_operator"] = sorted(bpy.ops.mcrecon.render(animation=True))
+    result["anim_denoised"] = [os.path.join(OUT, "anim_%04d_denoised.exr" % f) for f in (1, 2, 3)]
+    result["anim_noisy"] = [os.path.join(OUT, "anim_%04d.exr" % f) for f in (1, 2, 3)]
+    scene.frame_start = scene.frame_end = 1
+    scene.frame_set(1)
+    # A plain command-line render cannot run the compositor pass after its job: it says so and
+    # denoises the composite instead (an output, not nothing).
+    scene.render.filepath = os.path.join(OUT, "plain")
+    bpy.ops.render.render(write_still=True)
+    result["plain_message"] = mc.last_message
+    result["plain_denoised"] = os.path.join(OUT, "plain_denoised.exr")
+    # The oracle: the raw render (same seed), denoised by the CLI, through the same nodes.
+    mc.enabled = False
+    scene.render.use_compositing = False
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+    scene.render.filepath = os.path.join(OUT, "raw")
+    bpy.ops.render.render(write_still=True)
+    raw = os.path.join(OUT, "raw.exr")
+    cli = os.environ.get("MCRECON_BIN") or os.path.join(os.path.dirname(os.environ["MCRECON_ADDON_ZIP"]), "bin",
+                                                        "mcrecon")
+    clean = os.path.join(OUT, "cli_denoised.exr")
+    p = subprocess.run([cli, "denoise", raw, "-o", clean, "-f", "box", "--layer", "ViewLayer"],
+                       capture_output=True, text=True)
+    assert p.returncode == 0, p.stderr
+    scene.render.use_compositing = True
+    scene.render.image_settings.file_format = "OPEN_EXR"
+    rl.mute = True
+    img = tree.nodes.new("CompositorNodeImage")
+    img.image = bpy.data.images.load(clean)
+    tree.links.new(img.outputs["Image"], glare.inputs["Image"])
+    scene.render.filepath = os.path.join(OUT, "oracle")
+    bpy.ops.render.render(write_still=True)
+    result["oracle"] = os.path.join(OUT, "oracle.exr")
+    result["cli_denoised"] = clean
+
+
 def case_install_zip():
     scene = bpy.context.scene
     import mcrecon_addon.native as native
@@ -410,6 +482,7 @@ enable_addon()
  "passes": case_passes, "anim_bmfr": case_anim, "anim_accumulate": case_anim_accumulate,
  "errors": case_errors, "light_passes": case_light_passes,
  "composite": case_composite, "install_zip": case_install_zip, "hygiene": case_hygiene,
- "png_anim": case_png_anim, "denoise_files": case_denoise_files}[CASE]()
+ "png_anim": case_png_anim, "denoise_files": case_denoise_files,
+ "composite_before": case_composite_before}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

@@ -4,14 +4,16 @@
 
 Turns the 3D viewport into a Properties editor on the Render tab, enables the add-on on the
 sample room with bilateral, opens the Features sub-panel, renders with F12 (INVOKE, the render
-window), waits for the denoised result, takes screenshots (the panel; the render window) and
-writes OUT_DIR/gui.json with what it saw; then quits."""
+window), waits for the denoised result, takes screenshots (the panel; the render window); then
+adds a multiply after Render Layers and renders with F12 again (Denoise Before Compositing: the
+compositor pass runs from a timer) and writes OUT_DIR/gui.json with what it saw; then quits."""
 import json
 import os
 import sys
 
 import addon_utils
 import bpy
+import numpy as np
 
 OUT = sys.argv[sys.argv.index("--") + 2]
 state = {"step": 0, "waited": 0.0}
@@ -26,6 +28,17 @@ def area_of(kind):
         return None, None
     _, window, area = max(found, key=lambda t: t[0])
     return window, area
+
+
+GRADE = (0.5, 1.0, 2.0, 1.0)
+
+
+def pixels(img):
+    """An image's float pixels, (height, width, 4), bottom row first."""
+    w, h = img.size
+    a = np.empty(w * h * 4, np.float32)
+    img.pixels.foreach_get(a)
+    return a.reshape(h, w, 4)
 
 
 def finish():
@@ -85,6 +98,52 @@ def step():
             with bpy.context.temp_override(window=window, area=area):
                 bpy.ops.screen.screenshot(filepath=os.path.join(OUT, "render_window.png"))
         result["files_written"] = sorted(os.listdir(OUT))
+        result["status_history"] = list(__import__("mcrecon_addon.status", fromlist=["x"]).history)
+        # Denoise Before Compositing from the UI (the composite pass runs from a timer): a
+        # constant multiply after Render Layers must apply to the denoised image.
+        np.save(os.path.join(OUT, "plain.npy"), pixels(img))
+        scene.render.image_settings.file_format = "OPEN_EXR"
+        scene.render.image_settings.color_depth = "32"
+        scene.use_nodes = True
+        scene.render.use_compositing = True
+        tree = scene.node_tree
+        rl = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeRLayers")
+        comp = next(n for n in tree.nodes if n.bl_idname == "CompositorNodeComposite")
+        mul = tree.nodes.new("CompositorNodeMixRGB")
+        mul.blend_type = "MULTIPLY"
+        mul.inputs[2].default_value = GRADE
+        tree.links.new(rl.outputs["Image"], mul.inputs[1])
+        tree.links.new(mul.outputs["Image"], comp.inputs["Image"])
+        scene.mcrecon.last_message = ""
+        with bpy.context.temp_override(window=window, area=area):
+            bpy.ops.render.render("INVOKE_DEFAULT", write_still=False)
+        state["step"], state["waited"] = 3, 0.0
+        return 1.0
+    if state["step"] == 3:
+        if "compositor ran" not in scene.mcrecon.last_message and state["waited"] < 90:
+            state["waited"] += 1.0
+            return 1.0
+        result["composite_message"] = scene.mcrecon.last_message
+        img = bpy.data.images.get("mcrecon Result")
+        np.save(os.path.join(OUT, "graded.npy"), pixels(img))
+        result["grade"] = list(GRADE)
+        # F12 with an OpenEXR MultiLayer output (no file written: the passes come from the
+        # Render Result), again before compositing.
+        scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+        scene.mcrecon.last_message = ""
+        window, area = area_of("IMAGE_EDITOR")
+        with bpy.context.temp_override(window=window, area=area):
+            bpy.ops.render.render("INVOKE_DEFAULT", write_still=False)
+        state["step"], state["waited"] = 4, 0.0
+        return 1.0
+    if state["step"] == 4:
+        if "compositor ran" not in scene.mcrecon.last_message and state["waited"] < 90:
+            state["waited"] += 1.0
+            return 1.0
+        result["multilayer_message"] = scene.mcrecon.last_message
+        np.save(os.path.join(OUT, "graded_multilayer.npy"), pixels(bpy.data.images.get("mcrecon Result")))
+        result["files_after_composite"] = sorted(os.listdir(OUT))
+        result["temp_left"] = sorted(f for f in os.listdir(bpy.app.tempdir) if f.startswith("mcrecon"))
         finish()
         return None
 

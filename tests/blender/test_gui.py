@@ -1,6 +1,7 @@
 """Issue 16's GUI smoke test (ctest blender_addon_gui): Blender with a window under Xvfb opens
 the sample room, shows the add-on's panel on the Render tab, renders with F12 and shows the
-denoised result in the render window; the panel's screenshot is kept for the README
+denoised result in the render window with progress in the status bar, then (Denoise Before
+Compositing) the compositor's multiply applied to the denoised image; the panel's screenshot is kept for the README
 (OUT/panel.png). Skipped (exit 77) with a message where xvfb-run is absent; setup.sh installs it.
 Environment: MCRECON_BLENDER, MCRECON_SOURCE_DIR, MCRECON_ADDON_STAGE, MCRECON_TEST_TMP."""
 import json
@@ -9,6 +10,7 @@ import shutil
 import subprocess
 import sys
 
+import numpy as np
 import OpenImageIO as oiio
 
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -49,6 +51,26 @@ assert "ERROR" not in r["message"], r["message"]
 assert r["render_window_shows"] == "mcrecon Result", r["render_window_shows"]
 assert [f for f in r["files_written"] if "denoised" in f] == [], f"F12 wrote files: {r['files_written']}"
 assert "Normal" in r["passes_in_use"] and "Albedo" in r["passes_in_use"], r["passes_in_use"]
+# Progress in the status bar while the render-time denoise runs.
+hist = r["status_history"]
+assert any(t.startswith("mcrecon: denoising frame 1 with bilateral") for t in hist), hist
+assert any("denoised in" in t for t in hist), hist
+# Denoise Before Compositing from the UI: the multiply applies to the denoised image (the same
+# seed renders the same samples: the plain F12 result, times the grade).
+assert "compositor ran" in r["composite_message"], r["composite_message"]
+plain, graded = np.load(os.path.join(OUT, "plain.npy")), np.load(os.path.join(OUT, "graded.npy"))
+want = plain[..., :3] * np.array(r["grade"][:3], np.float32)
+err = float(np.abs(graded[..., :3] - want).max() / max(1e-6, float(np.abs(want).max())))
+assert graded.shape == plain.shape and err < 1e-3, f"the F12 composite is not the grade of the denoised image ({err})"
+# F12 with a MultiLayer output (nothing written: the passes come from the Render Result).
+assert "compositor ran" in r["multilayer_message"], r["multilayer_message"]
+ml = np.load(os.path.join(OUT, "graded_multilayer.npy"))
+err_ml = float(np.abs(ml[..., :3] - want).max() / max(1e-6, float(np.abs(want).max())))
+assert ml.shape == plain.shape and err_ml < 1e-3, f"F12 with MultiLayer output: not the graded denoised image ({err_ml})"
+assert [f for f in r["files_after_composite"] if "denoised" in f or "composite" in f] == [], r["files_after_composite"]
+assert r["temp_left"] == [], r["temp_left"]
+print(f"gui: status bar showed {hist[:2]}; F12 with a multiply after Render Layers gave the grade of the "
+      f"denoised image (max relative difference {err:.1e}; MultiLayer output {err_ml:.1e})")
 print(f"gui: panel screenshot {panel.spec().width}x{panel.spec().height} ({r['panel_png']}); F12 showed "
       f"'mcrecon Result' in the render window; passes in use: {', '.join(r['passes_in_use'])}")
 print("OK")
