@@ -158,6 +158,32 @@ class MCRECON_PT_changes(bpy.types.Panel):
         self.layout.operator("mcrecon.restore_scene")
 
 
+def draw_render_menu(self, context):
+    """Render menu entries (F3 finds them by "mcrecon")."""
+    layout = self.layout
+    layout.separator()
+    op = layout.operator("mcrecon.render", text="Render Denoised Image (mcrecon)", icon="RENDER_STILL")
+    op.animation = False
+    op = layout.operator("mcrecon.render", text="Render Denoised Animation (mcrecon)", icon="RENDER_ANIMATION")
+    op.animation = True
+    layout.operator("mcrecon.denoise_files", text="Denoise EXR Files (mcrecon)", icon="FILE_IMAGE")
+
+
+def draw_compositor_add_menu(self, context):
+    """The compositor's Add menu: Blender 3.4 cannot add a Python node, so this says where the
+    denoised image enters and holds the switches."""
+    if getattr(context.space_data, "tree_type", "") != "CompositorNodeTree" or not hasattr(context.scene, "mcrecon"):
+        return
+    layout = self.layout
+    layout.separator()
+    layout.label(text="mcrecon Denoiser (replaces Render Layers' Image)", icon="SHADERFX")
+    layout.prop(context.scene.mcrecon, "enabled", text="mcrecon Denoise Renders")
+    layout.prop(context.scene.mcrecon, "before_compositing")
+
+
+_menus = ((lambda: bpy.types.TOPBAR_MT_render, draw_render_menu),
+          (lambda: bpy.types.NODE_MT_add, draw_compositor_add_menu))
+
 _classes = (MCRECON_PT_render, MCRECON_PT_features, MCRECON_PT_fireflies, MCRECON_PT_foveation,
             MCRECON_PT_advanced, MCRECON_PT_changes)
 
@@ -165,8 +191,12 @@ _classes = (MCRECON_PT_render, MCRECON_PT_features, MCRECON_PT_fireflies, MCRECO
 def register():
     for c in _classes:
         bpy.utils.register_class(c)
+    for menu, fn in _menus:
+        menu().append(fn)
 
 
 def unregister():
+    for menu, fn in _menus:
+        menu().remove(fn)
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)

@@ -474,6 +474,10 @@ def case_install_zip():
     result["native_file"] = native.get().__file__
     result["has_settings"] = hasattr(scene, "mcrecon")
     result["panel"] = hasattr(bpy.types, "MCRECON_PT_render")
+    # F3 and the compositor's Add menu find "mcrecon": entries in the Render and Add menus.
+    result["menus"] = {m: sorted(f.__name__ for f in getattr(bpy.types, m)._dyn_ui_initialize()
+                                 if getattr(f, "__module__", "").startswith("mcrecon_addon"))
+                       for m in ("TOPBAR_MT_render", "NODE_MT_add")}
 
 
 enable_addon()

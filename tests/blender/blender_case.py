@@ -414,6 +414,7 @@ def check_composite_before():
 def check_install_zip():
     r, log = run_blender()
     assert r["has_settings"] and r["panel"]
+    assert r["menus"] == {"TOPBAR_MT_render": ["draw_render_menu"], "NODE_MT_add": ["draw_compositor_add_menu"]}, r["menus"]
     assert r["filters"] == mcrecon.filter_names()
     scripts = os.path.join(OUT, "scripts")
     assert os.path.realpath(r["native_file"]).startswith(os.path.realpath(scripts)), r["native_file"]
