@@ -6,7 +6,9 @@ Turns the 3D viewport into a Properties editor on the Render tab, enables the ad
 sample room with bilateral, opens the Features sub-panel, renders with F12 (INVOKE, the render
 window), waits for the denoised result, takes screenshots (the panel; the render window); then
 adds a multiply after Render Layers and renders with F12 again (Denoise Before Compositing: the
-compositor pass runs from a timer) and writes OUT_DIR/gui.json with what it saw; then quits."""
+compositor pass runs from a timer), in EXR and MultiLayer output; runs Denoise EXR Files on a
+40-frame sequence and presses Esc (event_simulate: run with --enable-event-simulate); writes
+OUT_DIR/gui.json with what it saw; then quits."""
 import json
 import os
 import sys
@@ -144,6 +146,26 @@ def step():
         np.save(os.path.join(OUT, "graded_multilayer.npy"), pixels(bpy.data.images.get("mcrecon Result")))
         result["files_after_composite"] = sorted(os.listdir(OUT))
         result["temp_left"] = sorted(f for f in os.listdir(bpy.app.tempdir) if f.startswith("mcrecon"))
+        # Denoise EXR Files in the UI (modal), then Esc.
+        window = bpy.context.window_manager.windows[0]
+        os.makedirs(os.path.join(OUT, "seq_out"))
+        with bpy.context.temp_override(window=window, screen=window.screen):
+            bpy.ops.mcrecon.denoise_files("EXEC_DEFAULT", filepath=os.path.join(OUT, "seq", "seq_0001.exr"),
+                                          output=os.path.join(OUT, "seq_out", "out_####.exr"), filter="box")
+        state["step"] = 5
+        return 0.05
+    if state["step"] == 5:
+        window = bpy.context.window_manager.windows[0]
+        window.event_simulate(type="ESC", value="PRESS")
+        result["esc_sent_at"] = len(os.listdir(os.path.join(OUT, "seq_out")))
+        state["step"], state["waited"] = 6, 0.0
+        return 1.0
+    if state["step"] == 6:
+        # Long enough for the rest of the sequence, had Esc not stopped it (about 0.1 s a frame).
+        if state["waited"] < 8:
+            state["waited"] += 1.0
+            return 1.0
+        result["seq_written"] = len(os.listdir(os.path.join(OUT, "seq_out")))
         finish()
         return None
 

@@ -29,11 +29,18 @@ blend = os.path.join(OUT, "room.blend")
 build = ("import sys, os, bpy; sys.path.insert(0, os.path.join(os.environ['MCRECON_SOURCE_DIR'], 'samples', "
          "'scenes')); import common as C, room; s = room.build(); C.configure_render(s, 320, 240); "
          "s.cycles.samples = 4; s.render.image_settings.file_format = 'PNG'; s.render.filepath = os.path.join(%r, 'render'); "
-         "bpy.ops.wm.save_as_mainfile(filepath=%r)" % (OUT, blend))
+         "bpy.ops.wm.save_as_mainfile(filepath=%r); "
+         # A MultiLayer render, copied into a sequence for Denoise EXR Files and Esc.
+         "s.render.image_settings.file_format = 'OPEN_EXR_MULTILAYER'; s.render.filepath = os.path.join(%r, 'seq_src'); "
+         "bpy.ops.render.render(write_still=True)" % (OUT, blend, OUT))
 p = subprocess.run([BLENDER, "-b", "--factory-startup", "--python-exit-code", "1", "--python-expr", build],
                    capture_output=True, text=True, timeout=120, env=env)
 assert p.returncode == 0, p.stdout[-3000:] + p.stderr[-3000:]
-p = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x2000x24", BLENDER, "--factory-startup", blend,
+SEQ = 40
+os.makedirs(os.path.join(OUT, "seq"))
+for f in range(1, SEQ + 1):
+    shutil.copy(os.path.join(OUT, "seq_src.exr"), os.path.join(OUT, "seq", "seq_%04d.exr" % f))
+p = subprocess.run(["xvfb-run", "-a", "-s", "-screen 0 1280x2000x24", BLENDER, "--factory-startup", "--enable-event-simulate", blend,
                     "--python", os.path.join(HERE, "gui_smoke.py"), "--", blend, OUT],
                    capture_output=True, text=True, timeout=240, env=env)
 log = p.stdout + p.stderr
@@ -62,6 +69,15 @@ plain, graded = np.load(os.path.join(OUT, "plain.npy")), np.load(os.path.join(OU
 want = plain[..., :3] * np.array(r["grade"][:3], np.float32)
 err = float(np.abs(graded[..., :3] - want).max() / max(1e-6, float(np.abs(want).max())))
 assert graded.shape == plain.shape and err < 1e-3, f"the F12 composite is not the grade of the denoised image ({err})"
+# Denoise EXR Files, modal, stopped by Esc (a simulated key press): it stops after the frame it
+# is on; every output written is complete, the rest are not started.
+outs = sorted(os.listdir(os.path.join(OUT, "seq_out")))
+assert r["esc_sent_at"] is not None, r
+assert len(outs) < SEQ, f"Esc did not stop Denoise EXR Files: {len(outs)} of {SEQ} written"
+for o in outs:
+    assert o.startswith("out_") and o.endswith(".exr"), f"a partial or temp file was left: {o}"
+    buf = oiio.ImageBuf(os.path.join(OUT, "seq_out", o))
+    assert buf.spec().width == 320 and not buf.has_error, (o, buf.geterror())
 # F12 with a MultiLayer output (nothing written: the passes come from the Render Result).
 assert "compositor ran" in r["multilayer_message"], r["multilayer_message"]
 ml = np.load(os.path.join(OUT, "graded_multilayer.npy"))
@@ -70,7 +86,7 @@ assert ml.shape == plain.shape and err_ml < 1e-3, f"F12 with MultiLayer output: 
 assert [f for f in r["files_after_composite"] if "denoised" in f or "composite" in f] == [], r["files_after_composite"]
 assert r["temp_left"] == [], r["temp_left"]
 print(f"gui: status bar showed {hist[:2]}; F12 with a multiply after Render Layers gave the grade of the "
-      f"denoised image (max relative difference {err:.1e}; MultiLayer output {err_ml:.1e})")
+      f"denoised image (max relative difference {err:.1e}; MultiLayer output {err_ml:.1e}); Esc stopped Denoise EXR Files after {len(outs)} of {SEQ} frames")
 print(f"gui: panel screenshot {panel.spec().width}x{panel.spec().height} ({r['panel_png']}); F12 showed "
       f"'mcrecon Result' in the render window; passes in use: {', '.join(r['passes_in_use'])}")
 print("OK")
