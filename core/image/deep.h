@@ -3,6 +3,7 @@
 // stored as separate arrays (structure of arrays) indexed through prefix offsets,
 // so a per-sample sweep reads one channel of all samples contiguously.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@ struct DeepSamples {
   std::vector<std::string> channel_names;  // e.g. R G B A Z dx dy
   std::vector<std::uint64_t> offsets;      // width*height+1 prefix sums of sample counts
   std::vector<std::vector<float>> values;  // values[channel][sample]
+  // Header attributes named "mcrecon:*" (the camera for the sweep's circle of confusion:
+  // mcrecon:lens_mm, mcrecon:fstop, mcrecon:focus_distance, mcrecon:sensor_width_mm), as text.
+  std::map<std::string, std::string> attributes;
 
   std::uint64_t total_samples() const { return offsets.empty() ? 0 : offsets.back(); }
   std::uint32_t samples(int x, int y) const {

@@ -6,6 +6,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <set>
 
@@ -36,6 +37,8 @@ std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec
   deep->width = spec.width;
   deep->height = spec.height;
   deep->channel_names.assign(spec.channelnames.begin(), spec.channelnames.end());
+  for (const ParamValue& a : spec.extra_attribs)
+    if (a.name().string().rfind("mcrecon:", 0) == 0) deep->attributes[a.name().string()] = a.get_string();
   const std::int64_t np = std::int64_t(spec.width) * spec.height;
   deep->offsets.assign(std::size_t(np) + 1, 0);
   for (std::int64_t p = 0; p < np; ++p) deep->offsets[std::size_t(p) + 1] = deep->offsets[std::size_t(p)] + dd.samples(p);
@@ -64,7 +67,26 @@ void read_deep(ImageInput& in, RawImage& raw, const std::string& path) {
   if (deepbuf.spec().width != raw.width || deepbuf.spec().height != raw.height)
     throw Error(Errc::ReadFailed, "'" + path + "' changed while it was read");
   raw.deep = copy_deep(*deepbuf.deepdata(), deepbuf.spec());
-  // Flat passes of a deep file: front-to-back composite of every channel.
+  if (deepbuf.spec().alpha_channel < 0) {
+    // No alpha: independent samples (the per-sample convention, README): the flat passes are
+    // the mean of each pixel's samples (Alg. 1 of Shirley et al., the 1-pixel box).
+    const DeepSamples& d = *raw.deep;
+    const std::size_t nc = d.channel_names.size(), np = std::size_t(raw.width) * std::size_t(raw.height);
+    raw.names = d.channel_names;
+    raw.pixels.assign(np * nc, 0.0f);
+    for (std::size_t p = 0; p < np; ++p) {
+      const std::uint64_t a = d.offsets[p], b = d.offsets[p + 1];
+      for (std::size_t c = 0; c < nc; ++c) {
+        double sum = 0;
+        std::uint64_t n = 0;
+        for (std::uint64_t i = a; i < b; ++i)
+          if (std::isfinite(d.values[c][i])) sum += d.values[c][i], ++n;
+        raw.pixels[p * nc + c] = n ? float(sum / double(n)) : 0.0f;
+      }
+    }
+    return;
+  }
+  // Flat passes of a deep file with alpha (compositing layers): front-to-back composite.
   ImageBuf flat = ImageBufAlgo::flatten(deepbuf);
   if (flat.has_error()) throw Error(Errc::ReadFailed, "cannot flatten deep '" + path + "': " + flat.geterror());
   raw.names.assign(flat.spec().channelnames.begin(), flat.spec().channelnames.end());
