@@ -101,7 +101,7 @@ int main(int argc, char** argv) {
                 mcr::relmse(ref, frame.image(mcr::Role::Colour).channel_range(0, 3), threads));
     const Run a = time_filter("auto", frame, ref, threads, repeat);
     double picked = 0;
-    for (const std::string& name : mcr::filter_names()) {
+    for (const std::string& name : mcr::image_filter_names()) {
       if (mcr::filter_info(name).temporal) continue;
       const Run r = time_filter(name, frame, ref, threads, repeat);
       if (name == a.chosen) picked = r.seconds;

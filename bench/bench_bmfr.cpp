@@ -198,7 +198,7 @@ void quality(int threads) {
       const std::vector<Image> out = run_filter(*f, scene.frames, threads, ms);
       print_row(judge(c.label, scene, out, ms));
     }
-    for (const std::string& name : filter_names()) {
+    for (const std::string& name : image_filter_names()) {
       if (name == "bmfr" || g_only_tries) continue;
       for (bool demod : {false, true}) {
         try {

@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
                   base.metrics.relmse, base.metrics.psnr, base.metrics.ssim);
       std::printf("%-8s %-10s %-50s %10s %10.5f %8.3f %7.4f\n", scene.name.c_str(), "(noisy)", (std::to_string(spp * 4) + " spp").c_str(), "-",
                   more.metrics.relmse, more.metrics.psnr, more.metrics.ssim);
-      for (const std::string& name : mcr::filter_names()) {
+      for (const std::string& name : mcr::image_filter_names()) {
         if (!mcr::bench::wanted(filters_wanted, name)) continue;
         const mcr::FilterInfo& info = mcr::filter_info(name);
         if (info.temporal) continue;  // sequences have their own benchmark

@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
       if (!mcr::bench::wanted(scenes_wanted, scene.name)) continue;
       const int spp = scene.is_sequence() ? scene.noisy.begin()->first : 16;
       const mcr::LoadedScene loaded = mcr::load_scene(scene, spp);
-      for (const std::string& name : mcr::filter_names()) {
+      for (const std::string& name : mcr::image_filter_names()) {
         if (!mcr::bench::wanted(filters_wanted, name)) continue;
         const mcr::FilterInfo& info = mcr::filter_info(name);
         // Temporal filters run on sequences; image filters on stills with their whole sweep,

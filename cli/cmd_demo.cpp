@@ -90,6 +90,7 @@ int run_demo(const DemoArgs& a) {
         auto filter = make_catalog_filter(name);
         filter->commit();
         if (!filter->missing_passes(loaded.frames.front()).empty()) continue;
+        if (filter->info().deep_input && !loaded.frames.front().deep) continue;  // per-sample scenes only
         Progress progress(scene.name + " " + name, int(loaded.frames.size()));
         Row row{scene.name, input, name, evaluate(loaded, filter.get(), a.threads, [&](int d, int) { progress.step(d, ""); })};
         progress.finish();

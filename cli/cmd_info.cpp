@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cstdint>
 #include <iostream>
 
 #include "commands.h"
@@ -11,6 +12,32 @@
 namespace mcr::cli {
 
 namespace {
+
+// The per-sample buffer: counts, channels, what the sweep's convention finds (README).
+nlohmann::json deep_report(const DeepSamples& d) {
+  std::uint64_t lo = UINT64_MAX, hi = 0, empty = 0;
+  const std::size_t np = std::size_t(d.width) * std::size_t(d.height);
+  for (std::size_t p = 0; p < np; ++p) {
+    const std::uint64_t n = d.offsets[p + 1] - d.offsets[p];
+    lo = std::min(lo, n);
+    hi = std::max(hi, n);
+    empty += n == 0;
+  }
+  nlohmann::json found = nlohmann::json::array(), missing = nlohmann::json::array(), camera = nlohmann::json::object();
+  for (const char* c : {"R", "G", "B", "Z"}) (d.channel(c) >= 0 ? found : missing).push_back(c);
+  for (const char* c : {"A", "dx", "dy", "blur", "mx", "my"})
+    if (d.channel(c) >= 0) found.push_back(c);
+  for (const auto& [k, v] : d.attributes) camera[k] = v;
+  return {{"samples", d.total_samples()},
+          {"per_pixel_min", np ? lo : 0},
+          {"per_pixel_mean", np ? double(d.total_samples()) / double(np) : 0.0},
+          {"per_pixel_max", hi},
+          {"empty_pixels", empty},
+          {"channels", d.channel_names},
+          {"convention_found", found},
+          {"convention_missing_required", missing},
+          {"camera", camera}};
+}
 
 struct InfoArgs {
   std::string input, layer;
@@ -44,6 +71,7 @@ int run_info(const InfoArgs& a) {
     const auto f = make_committed_filter(name, {});
     nlohmann::json missing = nlohmann::json::array(), uses = nlohmann::json::array();
     for (Role r : f->missing_passes(frame)) missing.push_back(role_name(r));
+    if (f->info().deep_input && !frame.deep) missing.push_back("per-sample (deep) input");
     for (Role r : f->needs().optional)
       if (frame.has(r)) uses.push_back(role_name(r));
     filters.push_back({{"name", name}, {"can_run", missing.empty()}, {"missing", missing}, {"uses", uses}});
@@ -52,12 +80,33 @@ int run_info(const InfoArgs& a) {
                       {"deep", bool(frame.deep)}, {"layers", frame.layers}, {"layer", frame.layer},
                       {"roles", roles},       {"passes", passes},         {"other_channels", other},
                       {"filters", filters}};
-  if (frame.deep) j["deep_samples"] = frame.deep->total_samples();
+  if (frame.deep) {
+    j["deep_samples"] = frame.deep->total_samples();
+    j["deep_buffer"] = deep_report(*frame.deep);
+  }
   if (a.json) {
     std::cout << j.dump(2) << "\n";
     return 0;
   }
   std::cout << frame.path << ": " << frame.width << "x" << frame.height << (frame.deep ? " deep" : "") << "\n";
+  if (frame.deep) {
+    const auto& d = j["deep_buffer"];
+    std::cout << "deep: " << d["samples"].get<std::uint64_t>() << " samples, per pixel min "
+              << d["per_pixel_min"].get<std::uint64_t>() << " mean " << d["per_pixel_mean"].get<double>() << " max "
+              << d["per_pixel_max"].get<std::uint64_t>() << " (" << d["empty_pixels"].get<std::uint64_t>()
+              << " pixels without samples)\n  channels:";
+    for (const auto& c : d["channels"]) std::cout << " " << c.get<std::string>();
+    std::cout << "\n  per-sample convention: found";
+    for (const auto& c : d["convention_found"]) std::cout << " " << c.get<std::string>();
+    if (!d["convention_missing_required"].empty()) {
+      std::cout << "; missing required";
+      for (const auto& c : d["convention_missing_required"]) std::cout << " " << c.get<std::string>();
+    }
+    std::cout << "\n  camera:";
+    if (d["camera"].empty()) std::cout << " (no mcrecon:* attributes)";
+    for (const auto& [k, v] : d["camera"].items()) std::cout << " " << k << "=" << v.get<std::string>();
+    std::cout << "\n";
+  }
   std::cout << "layers:";
   for (const auto& l : frame.layers) std::cout << " " << (l.empty() ? "(top level)" : l);
   std::cout << "\nusing layer: " << (frame.layer.empty() ? "(top level)" : frame.layer) << "\npasses:\n";

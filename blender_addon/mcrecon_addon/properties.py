@@ -176,7 +176,9 @@ def register():
         _classes.append(cls)
         ann[group_attr(info["name"])] = bpy.props.PointerProperty(type=cls)
     ann["filter"] = bpy.props.EnumProperty(
-        name="Filter", items=[(i["name"], panel_layout.filter_label(i["name"]), i["summary"]) for i in infos],
+        # A render is flat: per-sample filters (sweep) are for Denoise EXR Files on deep EXRs.
+        name="Filter", items=[(i["name"], panel_layout.filter_label(i["name"]), i["summary"]) for i in infos
+                              if i.get("input") != "deep"],
         # auto: a new user gets the filter that suits the render (and the passes it may read).
         default="auto", update=_on_filter_change,
         description="mcrecon filter (Render properties show its parameters)")

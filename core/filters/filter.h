@@ -25,6 +25,7 @@ struct FilterInfo {
   std::vector<Role> optional;  // passes it may use when present (under some setting)
   PrepSteps steps;             // the preparation steps it takes (their parameters end its table)
   bool temporal = false;       // keeps history between execute() calls (frame order matters)
+  bool deep_input = false;     // reads the frame's per-sample (deep) buffer; a flat frame is refused
   std::string nonfinite_policy;  // what it does with NaN/Inf input, for docs and `filters`
 };
 

@@ -7,6 +7,7 @@
 #include "filters/image/guided.h"
 #include "filters/image/gaussian.h"
 #include "filters/image/pwaf.h"
+#include "filters/samples/sweep.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -32,6 +33,7 @@ const std::vector<Entry>& entries() {
       entry<AtrousFilter>(),
       entry<PwafFilter>(),
       entry<BmfrFilter>(),
+      entry<SweepFilter>(),
   };
   return list;
 }
@@ -49,6 +51,13 @@ const Entry& find(const std::string& name) {
 std::vector<std::string> filter_names() {
   std::vector<std::string> names;
   for (const Entry& e : entries()) names.push_back(e.info().name);
+  return names;
+}
+
+std::vector<std::string> image_filter_names() {
+  std::vector<std::string> names;
+  for (const Entry& e : entries())
+    if (!e.info().deep_input) names.push_back(e.info().name);
   return names;
 }
 

@@ -218,6 +218,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   for (const std::string& name : filter_names()) {
     std::unique_ptr<Filter> f = make_filter(name);
     if (f->info().temporal) continue;  // a still has no history; temporal filters run by name
+    if (f->info().deep_input) continue;  // per-sample filters run by name, on deep input
     const std::vector<Role> missing = f->missing_passes(frame);
     if (!missing.empty()) {
       skipped += (skipped.empty() ? "" : ", ") + name + " (no " + role_name(missing[0]) + " pass)";

@@ -101,7 +101,7 @@ def case_passes():
     mc.enabled = True
     result["cycles_denoising"] = scene.cycles.use_denoising
     seen = {}
-    for info in native.get().filters():
+    for info in [i for i in native.get().filters() if i["input"] != "deep"]:  # render-time filters
         mc.filter = info["name"]
         group = getattr(mc, "params_" + info["name"])
         from mcrecon_addon import properties as props
@@ -328,7 +328,7 @@ def case_hygiene():
     mc = scene.mcrecon
     mc.enabled = True
     kept = {}
-    for info in native.get().filters():
+    for info in [i for i in native.get().filters() if i["input"] != "deep"]:  # render-time filters
         mc.filter = info["name"]
         for label, prop in (("", None), (" accumulate", "accumulate"), (" light passes", "light_passes")):
             if prop:

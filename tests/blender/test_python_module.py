@@ -201,9 +201,11 @@ def test_needs_match_info_and_settings(tmp):
         info = json.loads(cli("info", "--json", path))
         present = set(info["roles"])
         assert [f["name"] for f in info["filters"]] == mcrecon.filter_names()
+        deep = {f["name"] for f in mcrecon.filters() if f["input"] == "deep"}
         for entry in info["filters"]:
             n = mcrecon.needs(entry["name"])
-            assert entry["missing"] == [r for r in n["required"] if r not in present], (path, entry, n)
+            flat = ["per-sample (deep) input"] if entry["name"] in deep and not info["deep"] else []
+            assert entry["missing"] == [r for r in n["required"] if r not in present] + flat, (path, entry, n)
             assert entry["uses"] == [r for r in n["optional"] if r in present], (path, entry, n)
             assert entry["can_run"] == (not entry["missing"])
     colour_info = json.loads(cli("info", "--json", only_colour))

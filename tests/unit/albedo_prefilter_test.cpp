@@ -102,7 +102,7 @@ TEST(AlbedoPrefilter, DemodulationUsesTheSmoothedAlbedo) {
 }
 
 TEST(AlbedoPrefilter, EveryFilterStaysFiniteWithIt) {
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     Frame f = full_frame(20, 14, 5);
     pass_image(f, Role::Albedo).at(4, 4, 0) = kNaN;
     pass_image(f, Role::Albedo).at(9, 2, 2) = 0.0f;

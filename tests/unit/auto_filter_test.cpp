@@ -73,7 +73,7 @@ TEST(AutoFilter, ANoisyRenderIsFilteredAndTheChoiceIsAmongTheBest) {
     EXPECT_LT(err, 0.3 * in_err);
     // Within 2x of the best candidate's true error (the oracle: every candidate run whole).
     double best = 1e300;
-    for (const std::string& name : filter_names()) {
+    for (const std::string& name : image_filter_names()) {
       auto c = make_filter(name);
       if (c->info().temporal || !c->missing_passes(f).empty()) continue;
       c->commit();

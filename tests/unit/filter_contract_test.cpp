@@ -48,7 +48,7 @@ std::unique_ptr<Filter> with_every_step(const std::string& name, bool step_back 
 TEST(FilterContract, PixelsOutsideTheRegionKeepTheInputColour) {
   const int w = 26, h = 19;
   const Roi region{6, 4, 17, 13};
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     SCOPED_TRACE(name);
     const Frame f = busy_frame(w, h, 11);
     auto filter = with_every_step(name, true);
@@ -74,7 +74,7 @@ TEST(FilterContract, PixelsOutsideTheRegionKeepTheInputColour) {
 TEST(FilterContract, InsideTheRegionAsOnTheWholeFrame) {
   const int w = 26, h = 19;
   const Roi region{6, 4, 17, 13};
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     SCOPED_TRACE(name);
     if (make_filter(name)->info().temporal) continue;  // bmfr's blocks span the frame
     const Frame f = busy_frame(w, h, 12);
@@ -96,7 +96,7 @@ TEST(FilterContract, InsideTheRegionAsOnTheWholeFrame) {
 TEST(FilterContract, GenericAndBestInstructionSetsAgree) {
   if (best_isa() == Isa::Generic) GTEST_SKIP() << "this CPU has only the generic build";
   const int w = 40, h = 29;
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     SCOPED_TRACE(name);
     for (bool steps : {false, true}) {
       const Frame f = busy_frame(w, h, 13);

@@ -65,7 +65,7 @@ std::unique_ptr<Filter> committed(const std::string& name) {
 }
 
 TEST(FilterStress, EveryFilterKeepsAConstantImageConstant) {
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     if (filter_info(name).temporal) continue;  // history makes the first frames special
     Frame f = full_frame(23, 17, 1);
     for (float& v : pass_of(f, Role::Colour).image.storage()) v = 0.375f;
@@ -85,7 +85,7 @@ TEST(FilterStress, EveryFilterKeepsAConstantImageConstant) {
 // is legal input. Temporal filters run three frames of one static shot.
 TEST(FilterStress, ExtremeConstantsStayConstant) {
   const float big = std::numeric_limits<float>::max();
-  for (const std::string& name : filter_names())
+  for (const std::string& name : image_filter_names())
     for (float value : {big, -big, 1e30f, -1e30f, 1e-30f})
       for (bool demodulate : {false, true}) {
         auto filter = make_filter(name);
@@ -114,7 +114,7 @@ TEST(FilterStress, ExtremeConstantsStayConstant) {
 }
 
 TEST(FilterStress, DegenerateSizes) {
-  for (const std::string& name : filter_names())
+  for (const std::string& name : image_filter_names())
     for (auto [w, h] : {std::pair{1, 1}, {1, 9}, {9, 1}, {2, 2}, {3, 40}}) {
       auto filter = committed(name);
       expect_clean(name, *filter, full_frame(w, h, 2), std::to_string(w) + "x" + std::to_string(h));
@@ -122,7 +122,7 @@ TEST(FilterStress, DegenerateSizes) {
 }
 
 TEST(FilterStress, ExtremeMagnitudes) {
-  for (const std::string& name : filter_names())
+  for (const std::string& name : image_filter_names())
     for (float scale : {1e-30f, 1e30f, 3e38f}) {
       Frame f = full_frame(16, 12, 3);
       for (float& v : pass_of(f, Role::Colour).image.storage()) v *= scale;
@@ -139,7 +139,7 @@ TEST(FilterStress, ExtremeMagnitudes) {
 TEST(FilterStress, NonFiniteInColourAndEveryFeature) {
   const float bad[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
                        -std::numeric_limits<float>::infinity()};
-  for (const std::string& name : filter_names())
+  for (const std::string& name : image_filter_names())
     for (Role r : {Role::Colour, Role::Albedo, Role::Normal, Role::Position, Role::Depth, Role::Motion, Role::Variance,
                    Role::SecondPosition, Role::SecondNormal, Role::SampleCount})
       for (float b : bad) {
@@ -154,7 +154,7 @@ TEST(FilterStress, NonFiniteInColourAndEveryFeature) {
 }
 
 TEST(FilterStress, ZeroAlbedoWithDemodulation) {
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     Frame f = full_frame(18, 13, 6);
     for (float& v : pass_of(f, Role::Albedo).image.storage()) v = 0.0f;
     auto filter = make_filter(name);
@@ -169,7 +169,7 @@ TEST(FilterStress, ZeroAlbedoWithDemodulation) {
 // region is the whole frame.
 TEST(FilterStress, RegionNotInsideTheFrameIsRefused) {
   const Frame f = full_frame(18, 13, 7);
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     SCOPED_TRACE(name);
     auto filter = make_filter(name);
     filter->commit();
@@ -197,7 +197,7 @@ TEST(FilterStress, RegionNotInsideTheFrameIsRefused) {
 }
 
 TEST(FilterStress, AllEqualFeaturesAndFireflies) {
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     Frame f = full_frame(24, 24, 7);
     for (Role r : {Role::Albedo, Role::Normal, Role::Position, Role::Depth, Role::SecondPosition, Role::SecondNormal})
       for (float& v : pass_of(f, r).image.storage()) v = 0.5f;

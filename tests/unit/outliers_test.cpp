@@ -100,7 +100,7 @@ TEST(Fireflies, OffDarkPixelsAndNonFinite) {
 TEST(Fireflies, EveryFilterHasTheCommonParameters) {
   // On by default (k 8) in every image filter; off in bmfr, whose phase I sample limit
   // does that job (prepare/sample_limits.h).
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     const auto f = make_filter(name);
     EXPECT_EQ(f->params().get_float("firefly_k"), name == "bmfr" ? 0.0 : 8.0) << name;
     EXPECT_EQ(f->params().get_int("firefly_radius"), 3) << name;

@@ -135,7 +135,7 @@ TEST(StepBack, NonFiniteInputKeepsTheResultAndOnlyTheRegionChanges) {
 // Through a filter: on by default, noted, and off gives the filter's own result.
 TEST(StepBack, EveryImageFilterTakesItByDefault) {
   const Frame f = testutil::colour_frame(scene(40, 30, 0.2, 6));
-  for (const std::string& name : filter_names()) {
+  for (const std::string& name : image_filter_names()) {
     auto on = make_filter(name);
     if (on->info().temporal) {  // on by default, for a frame without history only (BmfrHighlights tests it)
       EXPECT_TRUE(on->params().get_bool("step_back")) << name;

@@ -43,6 +43,7 @@ const FilterInfo& SweepFilter::static_info() {
     }, PrepSteps::none());
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
     i.required = {Role::Colour};
+    i.deep_input = true;
     i.nonfinite_policy =
         "per sample: non-finite colour or coverage (A) <= 0 drops the sample; depth 0, negative, NaN, inf or "
         ">= 1e9 is the background (sorted last); a non-finite diameter is 1, a non-finite position the pixel "
