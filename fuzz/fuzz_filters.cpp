@@ -125,6 +125,24 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     frame.passes.push_back(std::move(p));
   }
 
+  if (filter->info().deep_input) {
+    // A per-sample buffer: 0..3 samples per pixel, every channel of the convention (README)
+    // from the pattern, non-finite values included.
+    auto deep = std::make_shared<mcr::DeepSamples>();
+    deep->width = w;
+    deep->height = h;
+    deep->channel_names = {"R", "G", "B", "Z", "A", "dx", "dy", "blur", "mx", "my"};
+    deep->offsets.assign(std::size_t(w) * std::size_t(h) + 1, 0);
+    for (std::size_t p = 0; p + 1 < deep->offsets.size(); ++p) {
+      const float a = std::fabs(pattern.value());
+      deep->offsets[p + 1] = deep->offsets[p] + (a < 1e6f ? std::uint64_t(a * 7.0f) % 4 : 3);
+    }
+    deep->values.assign(deep->channel_names.size(), std::vector<float>(deep->total_samples()));
+    for (auto& channel : deep->values)
+      for (float& v : channel) v = pattern.value();
+    frame.deep = deep;
+  }
+
   mcr::ScopedIsa isa(static_cast<mcr::Isa>(isa_level));
   const int runs = filter->info().temporal ? 3 : 1;
   for (int run = 0; run < runs; ++run) {

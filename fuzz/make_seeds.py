@@ -64,11 +64,17 @@ def write_parts(path, parts):
     out.close()
 
 
-def write_deep(path, w, h, counts, tile=None, compression="zips", rng=None):
-    names = ["R", "G", "B", "A", "Z"]
+def write_deep(path, w, h, counts, tile=None, compression="zips", rng=None, per_sample=False):
+    """per_sample: the sweep's convention (README): no alpha, R G B Z dx dy, camera attributes."""
+    names = ["R", "G", "B", "Z", "dx", "dy"] if per_sample else ["R", "G", "B", "A", "Z"]
     spec = oiio.ImageSpec(w, h, len(names), "float")
     spec.channelnames = tuple(names)
-    spec.alpha_channel, spec.z_channel = 3, 4
+    if per_sample:
+        spec.z_channel = 3
+        for k, v in (("lens_mm", 50.0), ("fstop", 0.2), ("focus_distance", 3.0), ("sensor_width_mm", 36.0)):
+            spec.attribute("mcrecon:" + k, v)
+    else:
+        spec.alpha_channel, spec.z_channel = 3, 4
     spec.deep = True
     spec.attribute("compression", compression)
     spec.attribute("DateTime", FIXED_TIME)
@@ -81,7 +87,7 @@ def write_deep(path, w, h, counts, tile=None, compression="zips", rng=None):
         dd.set_samples(p, n)
         for s in range(n):
             for c in range(len(names)):
-                v = 1.0 + s if c == 4 else float(rng.uniform(0.0, 1.0))
+                v = 1.0 + s if names[c] == "Z" else float(rng.uniform(0.0, 1.0))
                 dd.set_deep_value(p, c, s, v)
     out = oiio.ImageOutput.create(path)
     if out is None or not out.open(path, spec) or not out.write_deep_image(dd) or not out.close():
@@ -127,6 +133,7 @@ def deep_seeds(d, rng):
         write_deep(os.path.join(d, "deep_tiled_%s.exr" % name), 5, 4, counts, tile=2, rng=rng)
     write_deep(os.path.join(d, "deep_scan_none.exr"), 3, 3, [2], compression="none", rng=rng)
     write_deep(os.path.join(d, "deep_scan_rle.exr"), 3, 3, [1, 2], compression="rle", rng=rng)
+    write_deep(os.path.join(d, "deep_per_sample.exr"), 4, 3, [0, 1, 4], rng=rng, per_sample=True)
 
 
 # First byte: the filter (index into filter_names(): box guided gaussian bilateral atrous pwaf
