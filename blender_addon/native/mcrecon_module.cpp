@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "io/deep_writer.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
 #include "io/output_guard.h"
@@ -643,6 +644,49 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("input"), py::arg("output"), py::arg("display") = py::none(),
       "Writes the colour (and alpha) of a render or a denoised EXR in the format output's extension names, as "
       "denoise_file writes its result (display= as there): the add-on turns its denoised EXR into the user's PNG.");
+
+  m.def(
+      "write_deep",
+      [](const std::string& path, const py::dict& channels, const py::dict& attributes) {
+        mcr::check_output_path(path, {});
+        mcr::DeepSamples d;
+        std::vector<py::array_t<float, py::array::c_style | py::array::forcecast>> arrays;
+        std::size_t k = 0;
+        for (const auto& [key, value] : channels) {
+          const std::string name = py::str(key);
+          auto a = py::array_t<float, py::array::c_style | py::array::forcecast>::ensure(value);
+          if (!a || a.ndim() != 3)
+            throw mcr::Error(mcr::Errc::InvalidArgument, "write_deep: channel '" + name +
+                                                             "' must be an array of shape (samples, height, width)");
+          if (arrays.empty()) {
+            k = std::size_t(a.shape(0));
+            d.height = int(a.shape(1));
+            d.width = int(a.shape(2));
+          } else if (std::size_t(a.shape(0)) != k || a.shape(1) != d.height || a.shape(2) != d.width) {
+            throw mcr::Error(mcr::Errc::SizeMismatch, "write_deep: channel '" + name + "' has another shape than '" +
+                                                          d.channel_names.front() + "'");
+          }
+          d.channel_names.push_back(name);
+          arrays.push_back(a);
+        }
+        if (arrays.empty()) throw mcr::Error(mcr::Errc::InvalidArgument, "write_deep: no channel given");
+        for (const auto& [key, value] : attributes) d.attributes[py::str(key)] = py::str(value);
+        const std::size_t np = std::size_t(d.width) * std::size_t(d.height);
+        d.offsets.resize(np + 1);
+        for (std::size_t p = 0; p <= np; ++p) d.offsets[p] = p * k;
+        d.values.assign(arrays.size(), std::vector<float>(np * k));
+        for (std::size_t c = 0; c < arrays.size(); ++c) {
+          const float* src = arrays[c].data();  // [s][y][x] -> pixel-major
+          for (std::size_t s = 0; s < k; ++s)
+            for (std::size_t p = 0; p < np; ++p) d.values[c][p * k + s] = src[s * np + p];
+        }
+        py::gil_scoped_release release;
+        mcr::write_deep_samples(d, path);
+      },
+      py::arg("path"), py::arg("channels"), py::arg("attributes") = py::dict(),
+      "Writes a deep OpenEXR in the per-sample convention (README): channels {name: float array of shape "
+      "(samples, height, width)}, the same number of samples in every pixel, e.g. R, G, B, Z, dx, dy; "
+      "attributes {name: value} as header attributes (mcrecon:lens_mm, ...). Temp file + rename.");
 
   m.def(
       "needs",

@@ -144,6 +144,24 @@ class SweepEndToEnd(unittest.TestCase):
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertTrue(np.array_equal(rgb(pl_out), rgb(self.out)), "the plugin differs from the CLI")
 
+    def test_write_deep_makes_the_same_file(self):
+        """mcrecon.write_deep (what the Blender export uses) writes the samples as the convention
+        says: sweep on it gives the CLI's result on the file written here, bit for bit."""
+        sys.path.insert(0, os.environ.get("MCRECON_PYTHON_DIR") or os.path.join(tu.source_dir(), "build", "python"))
+        import mcrecon
+        a = np.array(self.px, np.float32).reshape(H, W, SPP, 6).transpose(2, 3, 0, 1)  # (sample, channel, y, x)
+        path = os.path.join(self.dir, "written.exr")
+        mcrecon.write_deep(path, {n: a[:, c] for c, n in enumerate(("R", "G", "B", "Z", "dx", "dy"))},
+                           {"mcrecon:lens_mm": LENS, "mcrecon:fstop": FSTOP, "mcrecon:focus_distance": FOCUS,
+                            "mcrecon:sensor_width_mm": SENSOR})
+        out = os.path.join(self.dir, "written_out.exr")
+        tu.run_cli("denoise", "-f", "sweep", path, "-o", out)
+        self.assertTrue(np.array_equal(rgb(out), rgb(self.out)))
+        self.assertEqual(tu.run_cli_json("info", "--json", path)["deep_buffer"]["samples"], W * H * SPP)
+        self.assertFalse([f for f in os.listdir(self.dir) if "mcrecon-tmp" in f])
+        with self.assertRaises(mcrecon.Error):
+            mcrecon.write_deep(os.path.join(self.dir, "bad.exr"), {"R": a[:, 0], "G": a[:2, 1]})
+
     def test_info_reports_the_deep_buffer(self):
         j = tu.run_cli_json("info", "--json", self.deep)
         d = j["deep_buffer"]
