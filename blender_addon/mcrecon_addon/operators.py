@@ -191,6 +191,41 @@ class MCRECON_OT_render(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class MCRECON_OT_export_deep(bpy.types.Operator):
+    """Render the current frame as K one-sample sub-renders and write them as one deep EXR for the per-sample filter sweep (depth of field, motion blur)"""
+    bl_idname = "mcrecon.export_deep"
+    bl_label = "Export Per-Sample EXR"
+    bl_options = {"REGISTER"}
+
+    filepath: bpy.props.StringProperty(name="Output", subtype="FILE_PATH", default="//samples.exr",
+                                       description="The deep OpenEXR to write")
+    samples: bpy.props.IntProperty(name="Samples", default=16, min=1, max=4096,
+                                   description="Samples per pixel: one 1-spp sub-render each (sample_offset 0..K-1)")
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        from . import deep_export
+        mc = native.get()
+        wm = context.window_manager
+        total = self.samples + (1 if context.scene.render.use_motion_blur else 0)
+        wm.progress_begin(0, total)
+        try:
+            info = deep_export.export(context.scene, self.filepath, self.samples,
+                                      progress=lambda done, n: wm.progress_update(done),
+                                      log=lambda m: print("mcrecon: " + m, flush=True))
+        except (ValueError, RuntimeError, mc.Error) as e:
+            self.report({"ERROR"}, f"mcrecon: export_deep: {e}" + (f" [{e.kind}]" if isinstance(e, mc.Error) else ""))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        self.report({"INFO"}, f"mcrecon: {bpy.path.abspath(self.filepath)}: {info['width']}x{info['height']}, "
+                              f"{info['samples']} samples per pixel; denoise with: mcrecon denoise -f sweep")
+        return {"FINISHED"}
+
+
 class MCRECON_OT_restore_scene(bpy.types.Operator):
     """Put back every scene setting mcrecon changed (passes, Cycles denoising, compositing) and remove the nodes it added"""
     bl_idname = "mcrecon.restore_scene"
@@ -217,7 +252,7 @@ class MCRECON_OT_report(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (MCRECON_OT_render, MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
+_classes = (MCRECON_OT_render, MCRECON_OT_export_deep, MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
 
 
 def register():

@@ -467,6 +467,56 @@ def case_composite_before():
     result["cli_denoised"] = clean
 
 
+def export_state(scene):
+    """What export_deep changes and must put back."""
+    r, cy, vl = scene.render, scene.cycles, scene.view_layers[0]
+    return {"filepath": r.filepath, "format": r.image_settings.file_format, "depth": r.image_settings.color_depth,
+            "compositing": r.use_compositing, "motion_blur": r.use_motion_blur, "samples": cy.samples,
+            "offset": cy.sample_offset, "filter_width": round(cy.filter_width, 6), "adaptive": cy.use_adaptive_sampling,
+            "aovs": [a.name for a in vl.aovs], "vector": vl.use_pass_vector,
+            "nodes": sorted(n.name for m in bpy.data.materials if m.node_tree for n in m.node_tree.nodes)}
+
+
+def case_export_deep():
+    """Issue 17: the per-sample export of the dof sample scene, and oracles rendered plainly."""
+    import dof
+    scene = dof.build()
+    C.configure_render(scene, 48, 32)
+    scene.cycles.seed = 5
+    scene.cycles.samples = 64
+    scene.cycles.filter_width = 1.5
+    scene.render.filepath = os.path.join(OUT, "user_output_")
+    result["before"] = export_state(scene)
+    result["op"] = sorted(bpy.ops.mcrecon.export_deep(filepath=os.path.join(OUT, "deep.exr"), samples=4))
+    result["after"] = export_state(scene)
+    # Oracles: the 4-spp render with the same seed and a 0.01 px filter; sample 0's Depth pass.
+    vl = scene.view_layers[0]
+    vl.use_pass_z = True
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+    scene.render.image_settings.color_depth = "32"
+    scene.cycles.filter_width = 0.01
+    scene.cycles.use_adaptive_sampling = False
+    for spp, name in ((4, "ref4"), (1, "depth0")):
+        scene.cycles.samples = spp
+        scene.render.filepath = os.path.join(OUT, name)
+        bpy.ops.render.render(write_still=True)
+    # Motion blur: the ball moves sideways over the frame; motion comes from a blur-free render.
+    ball = max((o for o in scene.objects if o.type == "MESH"), key=lambda o: -o.location.y)
+    ball.location.x -= 0.3
+    ball.keyframe_insert("location", frame=0)
+    ball.location.x += 0.6
+    ball.keyframe_insert("location", frame=2)
+    scene.frame_set(1)
+    scene.render.use_motion_blur = True
+    scene.render.filepath = os.path.join(OUT, "user_output_")
+    scene.cycles.filter_width = 1.5
+    result["moving"] = ball.name
+    result["before_motion"] = export_state(scene)
+    result["op_motion"] = sorted(bpy.ops.mcrecon.export_deep(filepath=os.path.join(OUT, "deep_motion.exr"), samples=2))
+    result["after_motion"] = export_state(scene)
+    result["temp_left"] = sorted(f for f in os.listdir(bpy.app.tempdir) if f.startswith("mcrecon"))
+
+
 def case_install_zip():
     scene = bpy.context.scene
     import mcrecon_addon.native as native
@@ -487,6 +537,6 @@ enable_addon()
  "errors": case_errors, "light_passes": case_light_passes,
  "composite": case_composite, "install_zip": case_install_zip, "hygiene": case_hygiene,
  "png_anim": case_png_anim, "denoise_files": case_denoise_files,
- "composite_before": case_composite_before}[CASE]()
+ "composite_before": case_composite_before, "export_deep": case_export_deep}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

@@ -411,6 +411,70 @@ def check_composite_before():
           "command-line render says how and denoises the composite")
 
 
+def read_deep(path):
+    """{channel: (samples, h, w)} of a deep EXR with the same count in every pixel; its header."""
+    inp = oiio.ImageInput.open(path)
+    assert inp, f"cannot open {path}: {oiio.geterror()}"
+    spec = inp.spec()
+    assert spec.deep, f"{path} is not deep"
+    dd = inp.read_native_deep_image()
+    inp.close()
+    names = list(spec.channelnames)
+    n = {dd.samples(p) for p in range(spec.width * spec.height)}
+    assert len(n) == 1, f"{path}: samples per pixel vary: {sorted(n)}"
+    k = n.pop()
+    out = {c: np.zeros((k, spec.height, spec.width), np.float32) for c in names}
+    for p in range(spec.width * spec.height):
+        y, x = divmod(p, spec.width)
+        for ci, c in enumerate(names):
+            for s in range(k):
+                out[c][s, y, x] = dd.deep_value(p, ci, s)
+    attrs = {a.name: a.value for a in spec.extra_attribs if a.name.startswith("mcrecon:")}
+    return out, attrs
+
+
+def check_export_deep():
+    """Issue 17: bpy.ops.mcrecon.export_deep on the dof sample scene (48x32, 4 samples): the
+    mean of its samples is the 4-spp render with the same seed and a 0.01 px filter, sample 0's
+    depth is the 1-spp render's Depth pass, the camera is in the header, `sweep` runs on it,
+    the scene is put back; with motion blur on, the moving ball has motion (mx, my)."""
+    r, log = run_blender()
+    assert r["op"] == ["FINISHED"] and r["op_motion"] == ["FINISHED"], (r["op"], log[-3000:])
+    for a, b in (("before", "after"), ("before_motion", "after_motion")):
+        changed = {k: (r[a][k], r[b][k]) for k in r[a] if r[a][k] != r[b][k]}
+        assert not changed, f"export_deep left settings changed: {changed}"
+    assert r["temp_left"] == [], r["temp_left"]
+    deep, attrs = read_deep(os.path.join(OUT, "deep.exr"))
+    assert list(deep) == ["R", "G", "B", "Z", "dx", "dy"], list(deep)
+    assert deep["R"].shape == (4, 32, 48), deep["R"].shape
+    for k in ("mcrecon:lens_mm", "mcrecon:fstop", "mcrecon:focus_distance", "mcrecon:sensor_width_mm"):
+        assert k in attrs, (k, attrs)
+    assert abs(float(attrs["mcrecon:fstop"]) - 1.2) < 1e-5 and abs(float(attrs["mcrecon:lens_mm"]) - 85) < 1e-4, attrs
+    mean = np.stack([deep[c].mean(axis=0) for c in "RGB"], axis=-1)
+    ref = rgb(os.path.join(OUT, "ref4.exr"))
+    err = float(np.abs(mean - ref).max() / max(1e-6, float(np.abs(ref).max())))
+    assert err < 1e-4, f"the samples' mean differs from the 4-spp render by {err} (relative to its maximum)"
+    z0 = deep["Z"][0]
+    names, px = all_channels(os.path.join(OUT, "depth0.exr"))
+    depth = px[:, :, names.index("ViewLayer.Depth.Z")]
+    hit = depth < 1e9
+    assert hit.mean() > 0.5, hit.mean()
+    zerr = float(np.abs(z0[hit] - depth[hit]).max() / depth[hit].max())
+    assert zerr < 1e-4 and np.all(z0[~hit] == 0), f"sample 0's depth differs from the Depth pass: {zerr}"
+    out = os.path.join(OUT, "sweep.exr")
+    p = subprocess.run([cli(), "denoise", "-f", "sweep", os.path.join(OUT, "deep.exr"), "-o", out, "-v"],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    got = rgb(out)
+    assert np.isfinite(got).all() and np.abs(got - mean).max() > 1e-3, "sweep changed nothing"
+    mdeep, mattrs = read_deep(os.path.join(OUT, "deep_motion.exr"))
+    assert "mx" in mdeep and "my" in mdeep and mdeep["R"].shape[0] == 2, list(mdeep)
+    moving = np.hypot(mdeep["mx"][0], mdeep["my"][0])
+    assert moving.max() > 0.5 and (moving < 1e-3).mean() > 0.3, (moving.max(), (moving < 1e-3).mean())
+    print(f"export_deep: 48x32x4 samples, mean vs the 4-spp render {err:.1e}, sample 0 depth vs the Depth pass "
+          f"{zerr:.1e}, motion up to {moving.max():.2f} px on the moving ball; settings put back")
+
+
 def check_install_zip():
     r, log = run_blender()
     assert r["has_settings"] and r["panel"]
@@ -427,5 +491,5 @@ def check_install_zip():
  "errors": check_errors, "light_passes": check_light_passes,
  "composite": check_composite, "install_zip": check_install_zip, "hygiene": check_hygiene,
  "png_anim": check_png_anim, "denoise_files": check_denoise_files,
- "composite_before": check_composite_before}[CASE]()
+ "composite_before": check_composite_before, "export_deep": check_export_deep}[CASE]()
 print("OK")
