@@ -515,6 +515,7 @@ def case_export_deep():
     result["op_motion"] = sorted(bpy.ops.mcrecon.export_deep(filepath=os.path.join(OUT, "deep_motion.exr"), samples=2))
     result["after_motion"] = export_state(scene)
     result["temp_left"] = sorted(f for f in os.listdir(bpy.app.tempdir) if f.startswith("mcrecon"))
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "shot.blend"))  # for the batch script
 
 
 def case_install_zip():

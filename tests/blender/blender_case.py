@@ -471,6 +471,16 @@ def check_export_deep():
     assert "mx" in mdeep and "my" in mdeep and mdeep["R"].shape[0] == 2, list(mdeep)
     moving = np.hypot(mdeep["mx"][0], mdeep["my"][0])
     assert moving.max() > 0.5 and (moving < 1e-3).mean() > 0.3, (moving.max(), (moving < 1e-3).mean())
+    # The batch script, without the UI, on the saved scene.
+    batch = os.path.join(OUT, "batch.exr")
+    p = subprocess.run([os.environ["MCRECON_BLENDER"], "-b", "--factory-startup", os.path.join(OUT, "shot.blend"),
+                        "--python", os.path.join(os.path.dirname(HERE), "..", "blender_addon", "export_deep_batch.py"),
+                        "--", batch, "--samples", "2", "--frame", "1", "--addon-dir", STAGE],
+                       capture_output=True, text=True, timeout=200,
+                       env=dict(os.environ, BLENDER_USER_CONFIG=os.path.join(OUT, "config"),
+                                BLENDER_USER_SCRIPTS=os.path.join(OUT, "scripts")))
+    assert p.returncode == 0 and os.path.exists(batch), p.stdout[-2000:] + p.stderr[-2000:]
+    assert read_deep(batch)[0]["R"].shape[0] == 2
     print(f"export_deep: 48x32x4 samples, mean vs the 4-spp render {err:.1e}, sample 0 depth vs the Depth pass "
           f"{zerr:.1e}, motion up to {moving.max():.2f} px on the moving ball; settings put back")
 
