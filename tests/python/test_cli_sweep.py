@@ -19,6 +19,8 @@ import OpenImageIO as oiio
 import mcrecon_testutil as tu
 
 W, H, SPP = 24, 18, 8
+PAPER = ("--set", "width=5", "--set", "step_back=0")
+PAPER_PARAMS = {"width": 5.0, "step_back": 0.0}
 LENS, FSTOP, FOCUS, SENSOR = 50.0, 0.1, 4.0, 36.0  # a strong defocus on 24 pixels
 
 
@@ -111,7 +113,8 @@ class SweepEndToEnd(unittest.TestCase):
         cls.deep = os.path.join(cls.dir, "defocus.exr")
         write_deep(cls.deep, cls.px)
         cls.out = os.path.join(cls.dir, "cli.exr")
-        cls.proc = tu.run_cli("denoise", "-f", "sweep", cls.deep, "-o", cls.out, "-v")
+        # The paper's algorithm (Appendix A: scales 1 and 5), without the step back.
+        cls.proc = tu.run_cli("denoise", "-f", "sweep", *PAPER, cls.deep, "-o", cls.out, "-v")
 
     @classmethod
     def tearDownClass(cls):
@@ -134,12 +137,12 @@ class SweepEndToEnd(unittest.TestCase):
         sys.path.insert(0, os.environ.get("MCRECON_PYTHON_DIR") or os.path.join(tu.source_dir(), "build", "python"))
         import mcrecon
         py_out = os.path.join(self.dir, "py.exr")
-        mcrecon.Session("sweep").denoise_file(self.deep, py_out)
+        mcrecon.Session("sweep", PAPER_PARAMS).denoise_file(self.deep, py_out)
         self.assertTrue(np.array_equal(rgb(py_out), rgb(self.out)), "Python differs from the CLI")
         plugin = os.environ.get("MCRECON_PLUGIN_DIR") or os.path.join(tu.source_dir(), "build", "lib")
         oiiotool = shutil.which("oiiotool") or "/usr/bin/oiiotool"
         pl_out = os.path.join(self.dir, "plugin.exr")
-        p = subprocess.run([oiiotool, self.deep + ".mcrecon?filter=sweep", "-o", pl_out], capture_output=True,
+        p = subprocess.run([oiiotool, self.deep + ".mcrecon?filter=sweep&width=5&step_back=0", "-o", pl_out], capture_output=True,
                            text=True, env=dict(os.environ, OIIO_LIBRARY_PATH=plugin), timeout=120)
         self.assertEqual(p.returncode, 0, p.stderr)
         self.assertTrue(np.array_equal(rgb(pl_out), rgb(self.out)), "the plugin differs from the CLI")
@@ -155,7 +158,7 @@ class SweepEndToEnd(unittest.TestCase):
                            {"mcrecon:lens_mm": LENS, "mcrecon:fstop": FSTOP, "mcrecon:focus_distance": FOCUS,
                             "mcrecon:sensor_width_mm": SENSOR})
         out = os.path.join(self.dir, "written_out.exr")
-        tu.run_cli("denoise", "-f", "sweep", path, "-o", out)
+        tu.run_cli("denoise", "-f", "sweep", *PAPER, path, "-o", out)
         self.assertTrue(np.array_equal(rgb(out), rgb(self.out)))
         self.assertEqual(tu.run_cli_json("info", "--json", path)["deep_buffer"]["samples"], W * H * SPP)
         self.assertFalse([f for f in os.listdir(self.dir) if "mcrecon-tmp" in f])

@@ -123,6 +123,8 @@ TEST(Sweep, AllBlurredIsTheWideBoxOfThePixelMeans) {
     for (auto& s : p) s[3] = z;
   SweepFilter f;
   set_camera(f);
+  f.set("width", 5.0);    // the paper's two scales, 1 and 5
+  f.set("step_back", 0.0);  // the sweep alone
   Image out = run(f, b.frame());
   for (int y = 2; y < 10; ++y)
     for (int x = 2; x < 14; ++x) {
@@ -268,6 +270,40 @@ TEST(Sweep, DeepEdgeCases) {
   Image o1 = run(f1, one.frame());
   EXPECT_FLOAT_EQ(o1.pixel(0, 0)[0], 0.5f);
   EXPECT_FLOAT_EQ(o1.pixel(0, 0)[2], 1.0f);
+}
+
+TEST(Sweep, StepBackKeepsCleanPixelsAndLetsNoisyOnesBlur) {
+  // Everything blurred (diameter 9). Left half: every sample of a pixel the same colour (a
+  // clean pixel: no spread), a checker of pixel colours; right half: samples spread widely.
+  const float z = depth_for_coc(9.0, 16);
+  DeepBuilder b(16, 8);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<float> u(0.0f, 1.0f);
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 16; ++x)
+      for (int k = 0; k < 16; ++k) {
+        const float v = x < 8 ? ((x + y) % 2 ? 1.0f : 0.2f) : 4.0f * u(rng);
+        b.add(x, y, v, v, v, z, u(rng), u(rng));
+      }
+  SweepFilter off, on;
+  for (SweepFilter* f : {&off, &on}) set_camera(*f);
+  off.set("step_back", 0.0);
+  on.set("step_back", 1.0);
+  Image a = run(off, b.frame()), c = run(on, b.frame());
+  for (int y = 0; y < 8; ++y)
+    for (int x = 0; x < 6; ++x) EXPECT_FLOAT_EQ(c.pixel(x, y)[0], float(b.mean(x, y))) << x << "," << y;
+  // Noisy pixels: within one standard error of their own mean, and mostly the sweep's result.
+  int kept = 0;
+  for (int y = 0; y < 8; ++y)
+    for (int x = 10; x < 16; ++x) {
+      const auto& v = b.px[std::size_t(y * 16 + x)];
+      double m = 0, s2 = 0;
+      for (const auto& s : v) m += s[0] / 16.0;
+      for (const auto& s : v) s2 += (s[0] - m) * (s[0] - m) / 15.0;
+      EXPECT_LE(std::fabs(c.pixel(x, y)[0] - m), std::sqrt(s2 / 16.0) * (1 + 1e-4) + 1e-6);
+      kept += c.pixel(x, y)[0] == a.pixel(x, y)[0];
+    }
+  EXPECT_GT(kept, 24);  // of 48
 }
 
 TEST(Sweep, ErrorsNameWhatIsMissing) {

@@ -36,6 +36,39 @@ void Camera::fill_from(const DeepSamples& deep, const std::string& path) {
   }
 }
 
+bool clamp_to_pixel(const SampleSet& set, int x, int y, double k, float out[3]) {
+  const std::size_t p = std::size_t(y) * std::size_t(set.width) + std::size_t(x);
+  const std::uint64_t a = set.offsets[p], b = set.offsets[p + 1];
+  if (b - a < 2 || !(k > 0)) return false;
+  double sq = 0, sq2 = 0, m[3] = {0, 0, 0};
+  for (std::uint64_t i = a; i < b; ++i) {
+    const StoredSample& s = set.samples[std::size_t(i)];
+    sq += s.q;
+    sq2 += double(s.q) * s.q;
+    for (int c = 0; c < 3; ++c) m[c] += double(s.q) * s.rgb[c];
+  }
+  if (!(sq > 0)) return false;
+  for (double& v : m) v /= sq;
+  const double n = double(b - a);
+  bool moved = false;
+  for (int c = 0; c < 3; ++c) {
+    double var = 0;
+    for (std::uint64_t i = a; i < b; ++i) {
+      const StoredSample& s = set.samples[std::size_t(i)];
+      const double d = s.rgb[c] - m[c];
+      var += double(s.q) * s.q * d * d;
+    }
+    // Variance of the weighted mean, with the n/(n-1) correction for the estimated mean.
+    const double se = std::sqrt(var / (sq * sq) * n / (n - 1));
+    const double lo = m[c] - std::sqrt(k) * se, hi = m[c] + std::sqrt(k) * se;
+    const float before = out[c];
+    out[c] = float(std::clamp(double(out[c]), lo, hi));
+    moved = moved || out[c] != before;
+  }
+  (void)sq2;
+  return moved;
+}
+
 bool is_background(float z) { return !(z > 0) || !(z < 1e9f); }
 
 namespace {

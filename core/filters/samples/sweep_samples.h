@@ -39,6 +39,12 @@ struct SampleSet {
   std::size_t background = 0;         // depth 0, non-finite, negative or >= 1e9
 };
 
+// The step back: keeps out[c] within sqrt(k) standard errors of the pixel's own sample mean
+// (coverage-weighted), per channel, where the pixel has 2 samples or more. A clean pixel
+// (many samples, little spread) keeps its own mean, a noisy one the reconstruction. Returns
+// true when a channel was moved.
+bool clamp_to_pixel(const SampleSet& set, int x, int y, double k, float out[3]);
+
 // Background depth: 0, inf or >= 1e9 (the convention in the README), NaN and negative too.
 bool is_background(float z);
 
