@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <cstdlib>
 
 #include "filters/samples/sweep_kernel.h"
 #include "filters/samples/sweep_samples.h"
@@ -127,12 +128,65 @@ void SweepFilter::run(const Frame& frame, const Image& colour, const Roi& roi, I
   const float widest = alg == "box" ? 1.0f : (alg == "splat" ? float(params_.get_float("width")) : o.scales.widest());
   const int R = std::max(0, int(std::ceil(widest * 0.5f - 0.5f)));
   const int w = frame.width, h = frame.height;
+  // Layered with odd integer widths: a box holds whole pixels, so each source pixel's samples
+  // are summed per layer once, and an output pixel adds up its neighbours' sums.
+  bool whole_pixels = layered_;
+  for (float s : o.scales.widths) whole_pixels = whole_pixels && s == std::floor(s) && int(s) % 2 == 1;
+  const int K = o.scales.size(), L = 2 * K - 1;
+  std::vector<sweep::LayerSums::Acc> pixel_sums;
+  if (whole_pixels) {
+    pixel_sums.resize(std::size_t(w) * std::size_t(h) * std::size_t(L));
+    parallel_rows(0, h, nthreads, [&](int y) {
+      sweep::LayerSums one(K);
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+        one.clear();
+        for (std::uint64_t i = set.offsets[p]; i < set.offsets[p + 1]; ++i) {
+          const sweep::StoredSample& st = set.samples[std::size_t(i)];
+          sweep::Sample s;
+          s.z = st.z;
+          s.d = st.d;
+          s.q = st.q;
+          std::copy(st.rgb, st.rgb + 3, s.rgb);
+          one.add(s, sweep::layer_of(s.z, s.d, o, focus), 0, o.power);
+        }
+        for (int l = 0; l < L; ++l) pixel_sums[p * std::size_t(L) + std::size_t(l)] = one.acc[std::size_t(l * K)];
+      }
+    });
+  }
+  // The narrowest box holding a neighbour pixel at offset (ox, oy): box j spans (w_j - 1)/2.
+  auto narrowest = [&](int ox, int oy) {
+    const int r = std::max(std::abs(ox), std::abs(oy));
+    int m = 0;
+    while (m < K - 1 && (int(o.scales.widths[std::size_t(m)]) - 1) / 2 < r) ++m;
+    return m;
+  };
   std::atomic<std::size_t> sorted{0}, stepped{0};
   const double step_k = params_.get_float("step_back");
   parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
     std::vector<sweep::Sample> local;
+    sweep::LayerSums sums(K);
     std::size_t sorted_row = 0, stepped_row = 0;
     for (int x = roi.x0; x < roi.x1; ++x) {
+      if (whole_pixels) {
+        sums.clear();
+        for (int yy = std::max(0, y - R); yy <= std::min(h - 1, y + R); ++yy)
+          for (int xx = std::max(0, x - R); xx <= std::min(w - 1, x + R); ++xx) {
+            const int m = narrowest(xx - x, yy - y);
+            const std::size_t p = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
+            for (int l = 0; l < L; ++l) {
+              const sweep::LayerSums::Acc& a = pixel_sums[p * std::size_t(L) + std::size_t(l)];
+              sweep::LayerSums::Acc& t = sums.acc[std::size_t(l * K + m)];
+              t.q += a.q;
+              t.qp += a.qp;
+              for (int c = 0; c < 3; ++c) t.c[c] += a.c[c];
+            }
+          }
+        float* o3 = out.pixel(x, y);
+        sweep::combine_layers(sums, o, o3);
+        if (step_k > 0) stepped_row += sweep::clamp_to_pixel(set, x, y, step_k, o3);
+        continue;
+      }
       local.clear();
       const float cx = float(x) + 0.5f, cy = float(y) + 0.5f;
       for (int yy = std::max(0, y - R); yy <= std::min(h - 1, y + R); ++yy)

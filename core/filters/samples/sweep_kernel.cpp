@@ -11,10 +11,13 @@ namespace {
 
 constexpr int kMaxScales = 8;
 
-// 1/s^2 inside the s x s square around the pixel centre, else 0 (Appendix A's box()^2).
+// 1/s^2 inside the s x s square around the pixel centre, else 0 (Appendix A's box()^2). The
+// square is half-open, [-s/2, s/2): the paper's |x| < s/2 but for a measure-zero edge, so that
+// an odd integer width holds whole pixels, whatever the samples' positions inside them (what
+// lets the filter sum the layered path per source pixel).
 inline float box(const Sample& s, float width) {
   const float r = 0.5f * width;
-  return (std::fabs(s.dx) < r && std::fabs(s.dy) < r) ? 1.0f / (width * width) : 0.0f;
+  return (s.dx >= -r && s.dx < r && s.dy >= -r && s.dy < r) ? 1.0f / (width * width) : 0.0f;
 }
 
 inline bool finish(double w, const double c[3], float out[3]) {
@@ -143,34 +146,37 @@ bool sweep(Sample* s, int n, const Options& o, float out[3], bool* sorted) {
   return finish(w, c, out);
 }
 
-bool layered(const Sample* s, int n, const Options& o, float focus, float out[3]) {
+int layer_of(float z, float d, const Options& o, float focus) {
+  const int K = o.scales.size();
+  const int k = assign(d, o.scales, false).k;
+  return z < focus ? (K - 1 - k) : (K - 1 + k);
+}
+
+void LayerSums::add(const Sample& si, int layer, int m, double power) {
+  Acc& a = acc[std::size_t(layer * K + m)];
+  const double qp = power == 1 ? double(si.q) : std::pow(double(si.q), power);
+  a.q += si.q;
+  a.qp += qp;
+  for (int ch = 0; ch < 3; ++ch) a.c[ch] += qp * si.rgb[ch];
+}
+
+void LayerSums::add(const LayerSums& o, int m_at_least) {
+  for (int layer = 0; layer < L; ++layer)
+    for (int m = 0; m < K; ++m) {
+      const Acc& from = o.acc[std::size_t(layer * K + m)];
+      Acc& to = acc[std::size_t(layer * K + std::max(m, m_at_least))];
+      to.q += from.q;
+      to.qp += from.qp;
+      for (int ch = 0; ch < 3; ++ch) to.c[ch] += from.c[ch];
+    }
+}
+
+bool combine_layers(const LayerSums& acc, const Options& o, float out[3]) {
   const Scales& sc = o.scales;
-  const int K = sc.size();
-  const int L = 2 * K - 1;  // near K-1 .. near 1, in focus (both sides), far 1 .. far K-1
-  // Per layer and per narrowest box holding the sample: sum q (coverage), q^p, q^p * rgb.
-  struct Acc {
-    double q = 0, qp = 0, c[3] = {0, 0, 0};
-  };
-  std::vector<Acc> acc(std::size_t(L * K));
-  std::vector<char> used(std::size_t(L), 0);
+  const int K = sc.size(), L = 2 * K - 1;
   const double p = o.power;
-  for (int i = 0; i < n; ++i) {
-    const Sample& si = s[i];
-    int m = 0;
-    while (m < K && box(si, sc.widths[std::size_t(m)]) == 0) ++m;
-    if (m == K) continue;  // outside the widest box
-    const int k = assign(si.d, sc, false).k;
-    const int layer = si.z < focus ? (K - 1 - k) : (K - 1 + k);
-    Acc& a = acc[std::size_t(layer * K + m)];
-    const double qp = p == 1 ? double(si.q) : std::pow(double(si.q), p);
-    a.q += si.q;
-    a.qp += qp;
-    for (int ch = 0; ch < 3; ++ch) a.c[ch] += qp * si.rgb[ch];
-    used[std::size_t(layer)] = 1;
-  }
   double w = 0, c[3] = {0, 0, 0}, cov[kMaxScales] = {0};
   for (int layer = 0; layer < L; ++layer) {
-    if (!used[std::size_t(layer)]) continue;
     const int k = layer < K ? (K - 1 - layer) : (layer - (K - 1));
     double others = 0;
     for (int j = 0; j < K; ++j)
@@ -178,7 +184,7 @@ bool layered(const Sample* s, int n, const Options& o, float focus, float out[3]
     const double free = std::max(0.0, 1.0 - others);
     double gained = 0;
     for (int m = 0; m < K; ++m) {
-      const Acc& a = acc[std::size_t(layer * K + m)];
+      const LayerSums::Acc& a = acc.acc[std::size_t(layer * K + m)];
       if (a.q == 0 && a.qp == 0) continue;
       // Box weight per unit q of a sample whose narrowest box is m: 1/s_j^2 for j >= m.
       auto b = [&](int j) { return j >= m ? 1.0 / (double(sc.widths[std::size_t(j)]) * sc.widths[std::size_t(j)]) : 0.0; };
@@ -193,6 +199,20 @@ bool layered(const Sample* s, int n, const Options& o, float focus, float out[3]
     cov[k] += free * gained;
   }
   return finish(w, c, out);
+}
+
+bool layered(const Sample* s, int n, const Options& o, float focus, float out[3]) {
+  const Scales& sc = o.scales;
+  const int K = sc.size();
+  LayerSums acc(K);
+  for (int i = 0; i < n; ++i) {
+    const Sample& si = s[i];
+    int m = 0;
+    while (m < K && box(si, sc.widths[std::size_t(m)]) == 0) ++m;
+    if (m == K) continue;  // outside the widest box
+    acc.add(si, layer_of(si.z, si.d, o, focus), m, o.power);
+  }
+  return combine_layers(acc, o, out);
 }
 
 }  // namespace mcr::sweep

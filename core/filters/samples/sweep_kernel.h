@@ -12,6 +12,7 @@
 // clamped at 0. With the same sample count in every pixel it never goes below 0; with
 // counts that differ between pixels it can, and a negative weight would let c/w leave the
 // samples' range.
+#include <algorithm>
 #include <vector>
 
 namespace mcr::sweep {
@@ -69,5 +70,24 @@ bool sweep(Sample* s, int n, const Options& o, float out[3], bool* sorted = null
 // samples of one scale on one side of the focus are contiguous in depth (a layer) and the
 // order inside a layer does not change the result. Requires o.blend = false.
 bool layered(const Sample* s, int n, const Options& o, float focus, float out[3]);
+
+// The layered path in two steps, for callers that sum whole pixels at once (the filter, when
+// the widths are odd integers: a box then holds whole pixels). Layer of a sample: 0 .. 2K-2,
+// front to back (near side widest first, in focus, far side).
+int layer_of(float z, float d, const Options& o, float focus);
+// Per layer and per narrowest box m holding the sample: sums of q, q^power and q^power * rgb.
+struct LayerSums {
+  struct Acc {
+    double q = 0, qp = 0, c[3] = {0, 0, 0};
+  };
+  int K, L;
+  std::vector<Acc> acc;
+  explicit LayerSums(int k) : K(k), L(2 * k - 1), acc(std::size_t(L * K)) {}
+  void clear() { std::fill(acc.begin(), acc.end(), Acc{}); }
+  void add(const Sample& s, int layer, int m, double power);
+  // Adds another's sums with every narrowest box raised to at least m_at_least.
+  void add(const LayerSums& other, int m_at_least);
+};
+bool combine_layers(const LayerSums& sums, const Options& o, float out[3]);
 
 }  // namespace mcr::sweep
