@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 
 namespace mcr::sweep {
 
@@ -25,7 +26,9 @@ inline bool finish(double w, const double c[3], float out[3]) {
     out[0] = out[1] = out[2] = 0;
     return false;
   }
-  for (int i = 0; i < 3; ++i) out[i] = float(c[i] / w);
+  // The mean of finite floats can round past the float range in double: clamp before the cast.
+  constexpr double kMax = std::numeric_limits<float>::max();
+  for (int i = 0; i < 3; ++i) out[i] = float(std::clamp(c[i] / w, -kMax, kMax));
   return true;
 }
 
