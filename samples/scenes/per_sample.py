@@ -3,7 +3,7 @@ add-on's export (K one-sample sub-renders) and a reference at many samples with 
 pixel filter (every sample at the pixel centre, as in the deep file), raw Combined.
 
     blender -b --factory-startup --python-exit-code 1 --python per_sample.py -- \\
-        --scene dof|motion|dof_garden --out DIR --addon-dir build/blender_addon/stage \\
+        --scene dof|motion|dof_garden|dof_spheres --out DIR --addon-dir build/blender_addon/stage \\
         [--spp 16] [--ref-spp 1024] [--width 128] [--height 96]
 
 Writes DIR/<scene>_<spp>spp_deep.exr and DIR/<scene>_ref.exr, and prints one JSON line

@@ -1,10 +1,10 @@
 """`sweep` on the per-sample sample scenes (samples/data/per_sample, issue 17) against their
 1024-spp references (same 0.01 px pixel filter): relMSE of Alg. 1 (the 1-pixel box: the samples'
 mean, what the renderer would have written), Alg. 1B (splat) and the sweep with its defaults.
-The defaults were chosen on the 'choice' scenes (dof, motion); dof_garden is held out. Checks:
-on the choice scenes the sweep beats the box and Alg. 1B without the step back (the paper's
-algorithm), and on every scene it is never worse than the box (a result worse than the input is
-a defect). Prints every figure (the README quotes them)."""
+The defaults were chosen on the 'choice' scenes (dof, motion); dof_garden and dof_spheres are
+held out. Checks: on the choice scenes the sweep beats the box and Alg. 1B without the step back
+(the paper's algorithm), and on every scene it is never worse than the box (a result worse than
+the input is a defect). Prints every figure (the README quotes them)."""
 import json
 import os
 import re
