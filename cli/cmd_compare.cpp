@@ -46,20 +46,22 @@ int run_compare(const CompareArgs& a) {
     return 0;
   }
   if (a.frames.empty()) throw Error(Errc::InvalidArgument, "comparing sequences needs --frames A-B");
-  const FrameRange r = parse_frame_range(a.frames);
+  const FrameList r = parse_frame_list(a.frames);
+  const int n = int(r.size());
   ImageMetrics mean{0, 0, 0, 0};
   double temporal = 0, temporal_ref = 0;
   nlohmann::json per_frame = nlohmann::json::array();
   Image prev, prev_ref;
-  Progress progress("compare", r.count());
-  for (int f = r.first; f <= r.last; ++f) {
+  Progress progress("compare", n);
+  for (int i = 0; i < n; ++i) {
+    const int f = r.frames()[std::size_t(i)];
     const Image ref = colour_of(sequence_path(a.reference, f), a.ref_layer);
     const Image img = colour_of(sequence_path(a.image, f), a.layer);
     const ImageMetrics m = compare_images(ref, img, a.threads);
-    mean.rmse += m.rmse / r.count();
-    mean.relmse += m.relmse / r.count();
-    mean.psnr += m.psnr / r.count();
-    mean.ssim += m.ssim / r.count();
+    mean.rmse += m.rmse / n;
+    mean.relmse += m.relmse / n;
+    mean.psnr += m.psnr / n;
+    mean.ssim += m.ssim / n;
     nlohmann::json j = metrics_json(m);
     j["frame"] = f;
     if (!prev.empty()) {
@@ -70,10 +72,10 @@ int run_compare(const CompareArgs& a) {
     per_frame.push_back(j);
     prev = img;
     prev_ref = ref;
-    progress.step(f - r.first + 1, "frame " + std::to_string(f));
+    progress.step(i + 1, "frame " + std::to_string(f));
   }
   progress.finish();
-  const int pairs = std::max(1, r.count() - 1);
+  const int pairs = std::max(1, n - 1);
   nlohmann::json out = metrics_json(mean);
   out["temporal_error"] = temporal / pairs;
   out["reference_temporal_error"] = temporal_ref / pairs;  // motion alone, for scale

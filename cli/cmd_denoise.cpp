@@ -9,6 +9,7 @@
 #include "io/exr_output.h"
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
+#include "pipeline/sequence_plan.h"
 #include "progress.h"
 #include "util/error.h"
 #include "validators.h"
@@ -24,6 +25,7 @@ struct DenoiseArgs {
   bool keep_passes = false, keep_components = false, timings = false, verbose = false, resume = false;
   bool accumulate = false;  // the accumulation stage before the filter
   int threads = 0;
+  int warmup = -1;  // --warmup N; -1: not given
   DisplayTransform display;  // PNG/JPEG/TIFF outputs
   int bits = 0;
 };
@@ -70,95 +72,112 @@ int run_denoise(const DenoiseArgs& a) {
   if (!a.region.empty()) eo.roi = parse_region(a.region);
 
   // Frame list: a single file, or a pattern with --frames.
-  std::vector<std::pair<std::string, std::string>> jobs;
-  std::vector<std::string> halves;  // per job: the second half buffer, when --half is given
   const bool seq = is_sequence_pattern(a.input);
   if (!a.half.empty() && seq != is_sequence_pattern(a.half))
     throw Error(Errc::InvalidArgument, "--half '" + a.half + "' must be a pattern exactly when the input '" + a.input + "' is");
-  if (seq) {
-    if (a.frames.empty()) throw Error(Errc::InvalidArgument, "input '" + a.input + "' is a sequence pattern: give --frames A-B");
-    if (!is_sequence_pattern(a.output))
-      throw Error(Errc::InvalidArgument, "output '" + a.output + "' must be a pattern (#### or %04d) for a sequence input");
-    const FrameRange r = parse_frame_range(a.frames);
-    for (long long f = r.first; f <= r.last; ++f) {  // long long: a range ending at INT_MAX ends
-      std::string in = sequence_path(a.input, int(f));
-      std::error_code ec;
-      if (!std::filesystem::exists(in, ec)) throw Error(Errc::FileNotFound, "cannot read '" + in + "': no such file");
-      jobs.emplace_back(std::move(in), sequence_path(a.output, int(f)));
-      if (!a.half.empty()) halves.push_back(sequence_path(a.half, int(f)));
-    }
-  } else {
-    if (!a.frames.empty()) throw Error(Errc::InvalidArgument, "--frames needs a sequence pattern (#### or %04d) as input");
-    jobs.emplace_back(a.input, a.output);
-    if (!a.half.empty()) halves.push_back(a.half);
-  }
+  const bool temporal = session.reconstruction().temporal();
+  const std::string filter_name = session.filter().info().name;
+  if (seq && a.frames.empty()) throw Error(Errc::InvalidArgument, "input '" + a.input + "' is a sequence pattern: give --frames A-B");
+  if (!seq && !a.frames.empty()) throw Error(Errc::InvalidArgument, "--frames needs a sequence pattern (#### or %04d) as input");
+  if (!seq && a.warmup >= 0) throw Error(Errc::InvalidArgument, "--warmup needs a sequence pattern (#### or %04d) as input");
+  if (seq && !is_sequence_pattern(a.output))
+    throw Error(Errc::InvalidArgument, "output '" + a.output + "' must be a pattern (#### or %04d) for a sequence input");
+  const FrameList frames = seq ? parse_frame_list(a.frames) : FrameList({0});
+  if (seq && temporal && !frames.consecutive())
+    throw Error(Errc::InvalidArgument, "--frames '" + a.frames + "': " + filter_name +
+                                           (a.accumulate ? " with --accumulate" : "") +
+                                           " carries history by one frame's motion, so its frames must be consecutive "
+                                           "(run each consecutive range on its own)");
+  auto input_of = [&](int f) { return seq ? sequence_path(a.input, f) : a.input; };
+  auto output_of = [&](int f) { return seq ? sequence_path(a.output, f) : a.output; };
+  auto half_of = [&](int f) { return a.half.empty() ? std::string() : seq ? sequence_path(a.half, f) : a.half; };
+
   // Check every frame before the first is filtered: a missing frame 90 of 100
   // or an output over an input should not cost a whole run.
   std::vector<std::string> inputs;
-  for (const auto& j : jobs) {
+  auto need_input = [&](int f, const std::string& why) {
+    const std::string in = input_of(f);
     std::error_code ec;
-    if (!std::filesystem::exists(j.first, ec)) throw Error(Errc::FileNotFound, "cannot read '" + j.first + "': no such file");
-    inputs.push_back(j.first);
-  }
-  for (std::string& f : loose_pass_files(ro)) inputs.push_back(std::move(f));  // --pass normal=n.exr
-  for (std::size_t i = 0; i < halves.size(); ++i) {
-    const std::string& h = halves[i];
-    std::error_code ec;
+    if (!std::filesystem::exists(in, ec)) throw Error(Errc::FileNotFound, "cannot read '" + in + "'" + why + ": no such file");
+    inputs.push_back(in);
+    const std::string h = half_of(f);
+    if (h.empty()) return;
     if (!std::filesystem::exists(h, ec)) throw Error(Errc::FileNotFound, "cannot read --half '" + h + "': no such file");
-    if (std::filesystem::equivalent(h, jobs[i].first, ec))
+    if (std::filesystem::equivalent(h, in, ec))
       throw Error(Errc::InvalidArgument, "--half '" + h + "' is the input itself: give the other half buffer");
     inputs.push_back(h);
-  }
-  std::vector<std::string> outputs;
-  for (const auto& j : jobs) outputs.push_back(j.second);
-  if (seq) check_sequence_outputs(a.output, parse_frame_range(a.frames), inputs);  // every frame its own file
-  else check_output_paths(outputs, inputs);
+  };
+  for (int f : frames.frames()) need_input(f, "");
+  const int warmup = temporal ? a.warmup : -1;
+  for (std::string& f : loose_pass_files(ro)) inputs.push_back(std::move(f));  // --pass normal=n.exr
+  if (seq) check_sequence_outputs(a.output, frames, inputs);  // every frame its own file
+  else check_output_paths({a.output}, inputs);
   check_write(a.output, wo);  // after the guard: a device or an input is the graver fault to name
 
-  const bool temporal = session.reconstruction().temporal();
   // Settings that change nothing: said once, not per frame.
   const std::vector<std::string>& unused = session.filter().unused_settings();
-  if (a.verbose)
+  if (a.verbose) {
     for (const auto& n : unused) std::cerr << "mcrecon: note: " << n << "\n";
-  Progress progress("denoise " + a.filter, int(jobs.size()));
-  StageTimes sum;
-  int written = 0, skipped = 0;
-  for (std::size_t i = 0; i < jobs.size(); ++i) {
-    const auto& [in, out] = jobs[i];
-    // --resume: an output counts as done only if it reads completely (a run killed by
-    // SIGKILL or a full disk may have left it cut short).
-    std::error_code ec;
-    bool done = a.resume && std::filesystem::exists(out, ec);
-    if (done) {
-      const std::string why = incomplete_file_reason(out);
-      if (!why.empty()) {
-        done = false;
-        const std::string note = "redo " + out + " (unreadable: " + why + ")";
-        if (seq) progress.step(int(i), note);
-        else std::cerr << "mcrecon: " << note << "\n";
+    if (!temporal && a.warmup >= 0)
+      std::cerr << "mcrecon: note: --warmup changes nothing: " << filter_name << " keeps no history\n";
+  }
+  // --resume: an output counts as done only if it reads completely (a run killed by
+  // SIGKILL or a full disk may have left it cut short) and its header names this filter,
+  // these parameters and this input; any other is redone.
+  std::vector<bool> done(frames.size(), false);
+  int redo = 0;
+  if (a.resume) {
+    const std::string params = session.reconstruction().parameters_text();
+    for (std::size_t i = 0; i < frames.size(); ++i) {
+      const int f = frames.frames()[i];
+      std::error_code ec;
+      if (!std::filesystem::exists(output_of(f), ec)) continue;
+      const std::string why = stale_output_reason(output_of(f), filter_name, params, input_of(f));
+      done[i] = why.empty();
+      if (done[i] && seq) std::cerr << "mcrecon: skip " << output_of(f) << " (done)\n";
+      if (!done[i]) {
+        ++redo;
+        std::cerr << "mcrecon: redo " << output_of(f) << " (" << why << ")\n";
       }
     }
-    if (done && !temporal) {
-      ++skipped;
-      if (seq) progress.step(int(i + 1), "skip " + out + " (exists)");
-      continue;
-    }
-    // Temporal filters replay finished frames without writing, to warm up history.
+  }
+  const std::vector<FrameJob> jobs = plan_sequence(frames, done, temporal, warmup);
+  // Warm-up frames before the list's first: they must exist, and no output may fall on one.
+  const std::size_t listed = inputs.size();
+  for (const FrameJob& j : jobs)
+    if (j.frame < frames.first()) need_input(j.frame, " (a --warmup " + std::to_string(a.warmup) + " frame)");
+  if (inputs.size() > listed) {
+    std::vector<std::string> outputs;
+    for (int f : frames.frames()) outputs.push_back(output_of(f));
+    check_output_paths(outputs, std::vector<std::string>(inputs.begin() + long(listed), inputs.end()));
+  }
+  const int skipped = int(std::count(done.begin(), done.end(), true));
+  Progress progress("denoise " + a.filter, int(jobs.size()));
+  if (seq && skipped)
+    std::cerr << "mcrecon: " << skipped << " of " << frames.size() << " frames already done"
+              << (redo ? ", " + std::to_string(redo) + " to redo" : "") << " (--resume)\n";
+  if (!seq && skipped) std::cerr << "mcrecon: " << a.output << " is done (same filter, parameters and input): kept (--resume)\n";
+  StageTimes sum;
+  int written = 0, replayed = 0;
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    const FrameJob& job = jobs[i];
+    const std::string in = input_of(job.frame), out = job.write ? output_of(job.frame) : std::string();
     ReadOptions frame_ro = ro;
-    if (!halves.empty()) frame_ro.second_half = halves[i];
-    const StageTimes t = session.run(in, done ? std::string() : out, frame_ro, wo, eo);
+    frame_ro.second_half = half_of(job.frame);
+    const StageTimes t = session.run(in, out, frame_ro, wo, eo);
     sum.read_ms += t.read_ms;
     sum.filter_ms += t.filter_ms;
     sum.write_ms += t.write_ms;
-    done ? ++skipped : ++written;
+    job.write ? ++written : ++replayed;
     if (a.verbose)
       for (const auto& n : session.reconstruction().notes())
         if (std::find(unused.begin(), unused.end(), n) == unused.end()) std::cerr << "mcrecon: " << in << ": " << n << "\n";
-    if (seq) progress.step(int(i + 1), (done ? "warm-up " + in : out) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
+    if (seq) progress.step(int(i + 1), (job.write ? out : "warm-up " + in) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
     else if (a.timings || a.verbose) std::cerr << "mcrecon: " << out << ": " << times_text(t) << "\n";
   }
   if (seq) {
-    progress.finish(std::to_string(written) + " written, " + std::to_string(skipped) + " already done");
+    progress.finish(std::to_string(written) + " written, " + std::to_string(skipped) + " already done" +
+                    (replayed ? ", " + std::to_string(replayed) + " read for history only" : ""));
     if (a.timings || a.verbose) std::cerr << "mcrecon: all frames: " << times_text(sum) << "\n";
   }
   return 0;
@@ -180,7 +199,7 @@ Run add_denoise(CLI::App& app) {
   app.add_option("-s,--set", a->sets, "filter parameter KEY=VALUE (repeatable)")->allow_extra_args(false);
   app.add_option("--layer", a->layer, "view layer (default: the first with a colour pass)");
   app.add_option("--pass", a->passes, "ROLE=FILE or ROLE=CHANNEL_GROUP override (repeatable)")->allow_extra_args(false);
-  app.add_option("--frames", a->frames, "frame range A-B for a sequence pattern");
+  app.add_option("--frames", a->frames, "frames of a sequence pattern as oiiotool writes them: 1-16, 1-16x2, 1-16y2, 1,5,9");
   app.add_option("--half", a->half,
                  "the other half buffer of the input (the same render's samples split in two, e.g. Blender's "
                  "sample_offset): filter their mean, with the noise from their difference (a pattern for sequences)");
@@ -202,7 +221,14 @@ Run add_denoise(CLI::App& app) {
   app.add_option("--ocio-config", a->display.config, "OpenColorIO config for the view (default: Blender's)")
       ->capture_default_str();
   app.add_option("--bit-depth", a->bits, "PNG/TIFF output: 8 or 16 bits per channel (default: PNG 8, TIFF 16; JPEG is 8)");
-  app.add_flag("--resume", a->resume, "skip frames whose output exists (temporal filters replay them without writing)");
+  app.add_flag("--resume", a->resume,
+               "keep outputs that exist, read completely and were made by the same filter, parameters and input "
+               "(others are redone); a temporal filter replays, without writing, only the done frames its history "
+               "needs");
+  app.add_option("--warmup", a->warmup,
+                 "temporal filters: run the history over the N frames before the first frame written, without "
+                 "writing them (a chunk of a split sequence then matches one run); default: from the first frame")
+      ->check(CLI::Range(0, 1000000));
   app.add_flag("--accumulate", a->accumulate,
                "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");
   app.add_flag("--timings", a->timings, "print read / filter / write times per frame");

@@ -25,5 +25,6 @@ Run add_denoise(CLI::App& app);
 Run add_compare(CLI::App& app);
 Run add_demo(CLI::App& app);
 Run add_sparsify(CLI::App& app);
+Run add_plan(CLI::App& app);
 
 }  // namespace mcr::cli

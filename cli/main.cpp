@@ -53,6 +53,8 @@ int main(int argc, char** argv) {
   add("filters", "list every filter with its parameter table", mcr::cli::add_filters);
   add("denoise", "run a filter on a render or a sequence", mcr::cli::add_denoise);
   add("compare", "error metrics of an image against a reference", mcr::cli::add_compare);
+  add("plan", "split a sequence's denoise into farm chunks: one command per chunk with warm-up and resume",
+      mcr::cli::add_plan);
   add("sparsify", "subsample a render with the thesis' foveated expanded grid (holes for pull-push)",
       mcr::cli::add_sparsify);
   add("demo", "run every filter on the sample scenes: table + side-by-side PNGs", mcr::cli::add_demo);

@@ -43,8 +43,11 @@ void check_in_range(const mcr::Filter& f) {
 
 void try_sequence(const std::string& line, int frame) {
   try {
-    const mcr::FrameRange r = mcr::parse_frame_range(line);
-    if (r.last < r.first) fail("parse_frame_range accepted last < first");
+    const mcr::FrameList r = mcr::parse_frame_list(line);
+    if (r.size() == 0 || r.size() > mcr::kMaxFrames) fail("parse_frame_list accepted no frame or too many");
+    for (std::size_t i = 1; i < r.size(); ++i)
+      if (r.frames()[i] <= r.frames()[i - 1]) fail("parse_frame_list accepted frames out of order");
+    if (r.size() <= 10000 && mcr::parse_frame_list(r.text()).frames() != r.frames()) fail("FrameList::text does not read back");
   } catch (const mcr::Error& e) {
     mcr::fuzz::expect_user_error(e);
   }

@@ -558,8 +558,7 @@ PYBIND11_MODULE(mcrecon, m) {
           if (!mcr::is_sequence_pattern(*p))
             throw mcr::Error(Errc::InvalidArgument, std::string(p == &input ? "input" : "output") + " '" + *p +
                                                         "' must be a sequence pattern (#### or %04d)");
-        if (last < first) throw mcr::Error(Errc::InvalidArgument, "frame range " + std::to_string(first) + "-" +
-                                                                        std::to_string(last) + " is empty");
+        const mcr::FrameList frames = mcr::FrameList::span(first, last);
         // Every input, and every output against them all, checked before the first frame is
         // filtered (as the CLI does); 64-bit counters: a range ending at INT_MAX ends.
         std::vector<std::string> inputs;
@@ -570,7 +569,7 @@ PYBIND11_MODULE(mcrecon, m) {
             throw mcr::Error(Errc::FileNotFound, "cannot read '" + inputs.back() + "': no such file");
         }
         for (std::string& f : mcr::loose_pass_files(read_options(layer, passes))) inputs.push_back(std::move(f));
-        mcr::check_sequence_outputs(output, {first, last}, inputs);
+        mcr::check_sequence_outputs(output, frames, inputs);
         Session s(filter, params, threads, accumulate);
         py::list outputs;
         for (std::int64_t f = first; f <= last; ++f) {

@@ -107,13 +107,13 @@ void check_output_path(const std::string& output, const std::vector<std::string>
   check_output_paths({output}, inputs);
 }
 
-void check_sequence_outputs(const std::string& pattern, const FrameRange& frames,
+void check_sequence_outputs(const std::string& pattern, const FrameList& frames,
                             const std::vector<std::string>& inputs) {
   std::vector<std::string> outputs;
-  for (long long f = frames.first; f <= frames.last; ++f) outputs.push_back(sequence_path(pattern, int(f)));
+  for (int f : frames.frames()) outputs.push_back(sequence_path(pattern, f));
   check_outputs(outputs, inputs, [&](std::size_t i, std::size_t j) {
-    return "output pattern '" + pattern + "' gives frames " + std::to_string(frames.first + (long long)i) + " and " +
-           std::to_string(frames.first + (long long)j) + " the same file '" + outputs[j] + "'";
+    return "output pattern '" + pattern + "' gives frames " + std::to_string(frames.frames()[i]) + " and " +
+           std::to_string(frames.frames()[j]) + " the same file '" + outputs[j] + "'";
   });
 }
 

@@ -22,7 +22,7 @@ void check_output_path(const std::string& output, const std::vector<std::string>
 void check_output_paths(const std::vector<std::string>& outputs, const std::vector<std::string>& inputs);
 // A sequence's outputs (pattern over frames), once for the whole run: an error names
 // the pattern and the two frames that would share a file.
-void check_sequence_outputs(const std::string& pattern, const FrameRange& frames,
+void check_sequence_outputs(const std::string& pattern, const FrameList& frames,
                             const std::vector<std::string>& inputs);
 
 // "the disk is full (No space left on device)" for ENOSPC, likewise EDQUOT and

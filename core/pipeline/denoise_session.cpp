@@ -4,6 +4,7 @@
 
 #include "io/exr_output.h"
 #include "io/output_guard.h"
+#include "pipeline/sequence_plan.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -59,6 +60,7 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     WriteOptions w = write;
     w.attributes.emplace_back("mcreconFilter", reconstruction_.filter().info().name);
     w.attributes.emplace_back("mcreconParameters", reconstruction_.parameters_text());
+    w.attributes.emplace_back("mcreconInput", input_stamp(input));  // --resume checks all three
     for (const ComponentImage& c : components)
       w.layers.emplace_back(component_layer_prefix(frame.layer) + c.name, &c.rgb);
     write_result(output, result, frame, w);

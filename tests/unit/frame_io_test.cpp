@@ -643,22 +643,47 @@ TEST(SequenceTest, PatternsAndPaths) {
 }
 
 TEST(SequenceTest, FrameRanges) {
-  FrameRange r = parse_frame_range("1-16");
-  EXPECT_EQ(r.first, 1);
-  EXPECT_EQ(r.last, 16);
-  EXPECT_EQ(r.count(), 16);
-  r = parse_frame_range("7");
-  EXPECT_EQ(r.first, 7);
-  EXPECT_EQ(r.count(), 1);
-  r = parse_frame_range(" 3 - 5 ");
-  EXPECT_EQ(r.count(), 3);
-  r = parse_frame_range("-2-1");
-  EXPECT_EQ(r.first, -2);
-  EXPECT_EQ(r.last, 1);
-  for (const char* bad : {"", "a", "1-", "-", "1-2-3", "5-1", "1..4", "1,2", "99999999999-1", "1-99999999999"}) {
-    const std::string msg = expect_error(Errc::InvalidArgument, [&] { parse_frame_range(bad); });
+  using V = std::vector<int>;
+  FrameList r = parse_frame_list("1-16");
+  EXPECT_EQ(r.first(), 1);
+  EXPECT_EQ(r.last(), 16);
+  EXPECT_EQ(r.size(), 16u);
+  EXPECT_TRUE(r.consecutive());
+  EXPECT_EQ(parse_frame_list("7").frames(), V{7});
+  EXPECT_EQ(parse_frame_list(" 3 - 5 ").frames(), (V{3, 4, 5}));
+  EXPECT_EQ(parse_frame_list("-2-1").frames(), (V{-2, -1, 0, 1}));
+  EXPECT_EQ(parse_frame_list("-8--5").frames(), (V{-8, -7, -6, -5}));
+  for (const char* bad : {"", "a", "1-", "-", "1-2-3", "5-1", "1..4", "99999999999-1", "1-99999999999", "1-4x0",
+                          "1,", ",1", "1,,2", "3,1", "2,2", "1-4,3", "1-4x", "1-4z2", "1-1y1", "1-2000000000"}) {
+    const std::string msg = expect_error(Errc::InvalidArgument, [&] { parse_frame_list(bad); });
     EXPECT_TRUE(contains(msg, "--frames")) << bad << ": " << msg;
   }
+}
+
+// The lists oiiotool's --frames gives for the same text (oiiotool --frames T --echo "{FRAME_NUMBER}").
+TEST(SequenceTest, FrameListsAsOiiotoolWritesThem) {
+  using V = std::vector<int>;
+  EXPECT_EQ(parse_frame_list("1-10x3").frames(), (V{1, 4, 7, 10}));
+  EXPECT_EQ(parse_frame_list("1-10y3").frames(), (V{2, 3, 5, 6, 8, 9}));
+  EXPECT_EQ(parse_frame_list("1,5,9").frames(), (V{1, 5, 9}));
+  EXPECT_EQ(parse_frame_list("1-3,7").frames(), (V{1, 2, 3, 7}));
+  EXPECT_EQ(parse_frame_list("1-16x2").frames(), (V{1, 3, 5, 7, 9, 11, 13, 15}));
+  EXPECT_EQ(parse_frame_list("1-4,9-13x2").frames(), (V{1, 2, 3, 4, 9, 11, 13}));
+  EXPECT_FALSE(parse_frame_list("1-10x3").consecutive());
+  // A span near the top of int ends; a huge step is one frame, not a long loop.
+  EXPECT_EQ(parse_frame_list("2147483646-2147483647").frames(), (V{2147483646, 2147483647}));
+  EXPECT_EQ(parse_frame_list("1-2147483647x2147483647").frames(), V{1});
+  EXPECT_EQ(parse_frame_list("-2147483648--2147483647").size(), 2u);
+  // text() reads back as the same list, in its shortest form.
+  for (const char* t : {"7", "1-16", "1-10x3", "1-10y3", "1,5,9", "-3-4"}) {
+    const FrameList l = parse_frame_list(t);
+    EXPECT_EQ(parse_frame_list(l.text()).frames(), l.frames()) << t << " -> " << l.text();
+  }
+  EXPECT_EQ(parse_frame_list("1,2,3").text(), "1-3");
+  EXPECT_EQ(parse_frame_list("1,3,5").text(), "1-5x2");
+  EXPECT_EQ(FrameList::span(3, 5).frames(), (V{3, 4, 5}));
+  expect_error(Errc::InvalidArgument, [] { FrameList::span(5, 3); });
+  expect_error(Errc::InvalidArgument, [] { FrameList::span(0, 2000000000); });
 }
 
 }  // namespace

@@ -84,16 +84,16 @@ TEST(OutputGuard, SequenceOutputsAreDistinctAndNeverAnInput) {
   ScratchDir dir("mcrecon_guard");
   std::ofstream(dir.path("in_0002.exr")) << "render";
   const std::vector<std::string> inputs = {dir.path("in_0001.exr"), dir.path("in_0002.exr")};
-  check_sequence_outputs(dir.path("out_" + std::string(40, '#') + ".exr"), {1, 2}, inputs);  // wide: fine
+  check_sequence_outputs(dir.path("out_" + std::string(40, '#') + ".exr"), FrameList::span(1, 2), inputs);  // wide: fine
 
   // Every frame onto one file through "..": the pattern and both frames are named.
   fs::create_directories(dir.path("d_0001"));
   const std::string pattern = dir.path("d_####/../out.exr");
-  std::string msg = expect_error(Errc::InvalidArgument, [&] { check_sequence_outputs(pattern, {1, 3}, inputs); });
+  std::string msg = expect_error(Errc::InvalidArgument, [&] { check_sequence_outputs(pattern, FrameList::span(1, 3), inputs); });
   EXPECT_TRUE(contains(msg, pattern) && contains(msg, "frames 1 and 2")) << msg;
 
   msg = expect_error(Errc::InvalidArgument,
-                     [&] { check_sequence_outputs(dir.path("./in_####.exr"), {1, 2}, inputs); });
+                     [&] { check_sequence_outputs(dir.path("./in_####.exr"), FrameList::span(1, 2), inputs); });
   EXPECT_TRUE(contains(msg, "in_0001.exr") && contains(msg, "never overwritten")) << msg;
   // Outputs given as a list: two spellings of one file.
   msg = expect_error(Errc::InvalidArgument,
