@@ -24,6 +24,7 @@ struct DenoiseArgs {
   std::vector<std::string> sets, passes;
   bool keep_passes = false, keep_components = false, timings = false, verbose = false, resume = false;
   bool accumulate = false;  // the accumulation stage before the filter
+  bool serial = false;      // --serial: no overlap of read, filter and write
   int threads = 0;
   int warmup = -1;  // --warmup N; -1: not given
   DisplayTransform display;  // PNG/JPEG/TIFF outputs
@@ -159,22 +160,26 @@ int run_denoise(const DenoiseArgs& a) {
   if (!seq && skipped) std::cerr << "mcrecon: " << a.output << " is done (same filter, parameters and input): kept (--resume)\n";
   StageTimes sum;
   int written = 0, replayed = 0;
-  for (std::size_t i = 0; i < jobs.size(); ++i) {
-    const FrameJob& job = jobs[i];
-    const std::string in = input_of(job.frame), out = job.write ? output_of(job.frame) : std::string();
-    ReadOptions frame_ro = ro;
-    frame_ro.second_half = half_of(job.frame);
-    const StageTimes t = session.run(in, out, frame_ro, wo, eo);
+  std::vector<DenoiseSession::Job> session_jobs;
+  for (const FrameJob& job : jobs) {
+    DenoiseSession::Job j{input_of(job.frame), job.write ? output_of(job.frame) : std::string(), ro};
+    j.read.second_half = half_of(job.frame);
+    session_jobs.push_back(std::move(j));
+  }
+  // Sequences overlap reading, filtering and writing unless --serial; one frame has nothing to overlap.
+  session.run_sequence(session_jobs, wo, eo, seq && !a.serial, [&](std::size_t i, const StageTimes& t) {
+    const std::string& in = session_jobs[i].input;
+    const std::string& out = session_jobs[i].output;
     sum.read_ms += t.read_ms;
     sum.filter_ms += t.filter_ms;
     sum.write_ms += t.write_ms;
-    job.write ? ++written : ++replayed;
+    out.empty() ? ++replayed : ++written;
     if (a.verbose)
-      for (const auto& n : session.reconstruction().notes())
+      for (const auto& n : t.notes)
         if (std::find(unused.begin(), unused.end(), n) == unused.end()) std::cerr << "mcrecon: " << in << ": " << n << "\n";
-    if (seq) progress.step(int(i + 1), (job.write ? out : "warm-up " + in) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
+    if (seq) progress.step(int(i + 1), (out.empty() ? "warm-up " + in : out) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
     else if (a.timings || a.verbose) std::cerr << "mcrecon: " << out << ": " << times_text(t) << "\n";
-  }
+  });
   if (seq) {
     progress.finish(std::to_string(written) + " written, " + std::to_string(skipped) + " already done" +
                     (replayed ? ", " + std::to_string(replayed) + " read for history only" : ""));
@@ -231,6 +236,9 @@ Run add_denoise(CLI::App& app) {
       ->check(CLI::Range(0, 1000000));
   app.add_flag("--accumulate", a->accumulate,
                "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");
+  app.add_flag("--serial", a->serial,
+               "sequences: read, filter and write one frame after the other (by default the next frame is read and "
+               "the last written while one is filtered: faster, three frames in memory instead of one)");
   app.add_flag("--timings", a->timings, "print read / filter / write times per frame");
   app.add_flag("-v,--verbose", a->verbose, "timings plus the filter's notes");
   return [a] { return run_denoise(*a); };

@@ -1,6 +1,8 @@
 #include "pipeline/denoise_session.h"
 
 #include <chrono>
+#include <future>
+#include <memory>
 
 #include "io/exr_output.h"
 #include "io/output_guard.h"
@@ -26,8 +28,18 @@ DenoiseSession::DenoiseSession(const std::string& filter,
                                const std::vector<std::pair<std::string, std::string>>& params, bool accumulate)
     : reconstruction_(make_committed_filter(filter, params), accumulate) {}
 
-StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
-                               const WriteOptions& write, const ExecOptions& exec) {
+// One frame between the stages: the input as read, the result and its components, and the
+// header strings, fixed when it was filtered (the writer may run on another thread).
+struct DenoiseSession::Filtered {
+  Frame frame;
+  Image result;
+  std::vector<ComponentImage> components;
+  std::vector<std::pair<std::string, std::string>> attributes;
+  StageTimes times;
+};
+
+Frame DenoiseSession::read_checked(const std::string& input, const std::string& output, const ReadOptions& read,
+                                   const WriteOptions& write) const {
   if (write.keep_components) check_keep_components(reconstruction_.filter().params());
   if (!read.second_half.empty() && reconstruction_.light_passes())
     // Two half buffers are merged by their colour pass only (io/half_buffers.h): the light
@@ -43,30 +55,83 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     check_output_path(output, inputs);
     check_write(output, write);  // Python and the add-on too: what the name says, or an error
   }
-  StageTimes t;
-  auto t0 = std::chrono::steady_clock::now();
-  Frame frame = read_frame(input, read);
-  t.read_ms = ms_since(t0);
+  return read_frame(input, read);
+}
 
-  t0 = std::chrono::steady_clock::now();
+void DenoiseSession::filter_into(Filtered& f, const WriteOptions& write, const ExecOptions& exec) {
+  const auto t0 = std::chrono::steady_clock::now();
   // The frame is ours: with accumulation its colour becomes the accumulated one, which
   // the writer never reads (it takes alpha and the other channels from it).
-  std::vector<ComponentImage> components;
-  const Image result = reconstruction_.run_in_place(frame, exec, write.keep_components ? &components : nullptr);
-  t.filter_ms = ms_since(t0);
+  f.result = reconstruction_.run_in_place(f.frame, exec, write.keep_components ? &f.components : nullptr);
+  f.times.filter_ms = ms_since(t0);
+  f.times.notes = reconstruction_.notes();
+  f.attributes = {{"mcreconFilter", reconstruction_.filter().info().name},
+                  {"mcreconParameters", reconstruction_.parameters_text()},
+                  {"mcreconInput", input_stamp(f.frame.path)}};  // --resume checks all three
+}
 
+void DenoiseSession::write_filtered(const std::string& output, const Filtered& f, const WriteOptions& write) {
+  WriteOptions w = write;
+  w.attributes.insert(w.attributes.end(), f.attributes.begin(), f.attributes.end());
+  for (const ComponentImage& c : f.components)
+    w.layers.emplace_back(component_layer_prefix(f.frame.layer) + c.name, &c.rgb);
+  write_result(output, f.result, f.frame, w);
+}
+
+StageTimes DenoiseSession::run(const std::string& input, const std::string& output, const ReadOptions& read,
+                               const WriteOptions& write, const ExecOptions& exec) {
+  Filtered f;
+  auto t0 = std::chrono::steady_clock::now();
+  f.frame = read_checked(input, output, read, write);
+  f.times.read_ms = ms_since(t0);
+  filter_into(f, write, exec);
   if (!output.empty()) {
     t0 = std::chrono::steady_clock::now();
-    WriteOptions w = write;
-    w.attributes.emplace_back("mcreconFilter", reconstruction_.filter().info().name);
-    w.attributes.emplace_back("mcreconParameters", reconstruction_.parameters_text());
-    w.attributes.emplace_back("mcreconInput", input_stamp(input));  // --resume checks all three
-    for (const ComponentImage& c : components)
-      w.layers.emplace_back(component_layer_prefix(frame.layer) + c.name, &c.rgb);
-    write_result(output, result, frame, w);
-    t.write_ms = ms_since(t0);
+    write_filtered(output, f, write);
+    f.times.write_ms = ms_since(t0);
   }
-  return t;
+  return f.times;
+}
+
+void DenoiseSession::run_sequence(const std::vector<Job>& jobs, const WriteOptions& write, const ExecOptions& exec,
+                                  bool pipelined, const std::function<void(std::size_t, const StageTimes&)>& done) {
+  if (!pipelined) {
+    for (std::size_t i = 0; i < jobs.size(); ++i) done(i, run(jobs[i].input, jobs[i].output, jobs[i].read, write, exec));
+    return;
+  }
+  // The reader and the writer are one thread each beside the filter's; one frame waits in
+  // each. Futures from std::async join in their destructors, so an error thrown below still
+  // waits for the write in flight: it completes or removes its temp file.
+  auto read_job = [&](std::size_t i) {
+    auto f = std::make_unique<Filtered>();
+    const auto t0 = std::chrono::steady_clock::now();
+    f->frame = read_checked(jobs[i].input, jobs[i].output, jobs[i].read, write);
+    f->times.read_ms = ms_since(t0);
+    return f;
+  };
+  std::future<std::unique_ptr<Filtered>> next;
+  std::future<StageTimes> writing;
+  std::size_t writing_index = 0;
+  if (!jobs.empty()) next = std::async(std::launch::async, read_job, 0);
+  for (std::size_t i = 0; i < jobs.size(); ++i) {
+    std::unique_ptr<Filtered> f = next.get();
+    if (i + 1 < jobs.size()) next = std::async(std::launch::async, read_job, i + 1);
+    filter_into(*f, write, exec);
+    if (writing.valid()) done(writing_index, writing.get());
+    if (jobs[i].output.empty()) {
+      done(i, f->times);
+      continue;
+    }
+    writing_index = i;
+    writing = std::async(std::launch::async, [&write, out = jobs[i].output, g = std::move(f)]() {
+      const auto t0 = std::chrono::steady_clock::now();
+      write_filtered(out, *g, write);
+      StageTimes t = g->times;
+      t.write_ms = ms_since(t0);
+      return t;
+    });
+  }
+  if (writing.valid()) done(writing_index, writing.get());
 }
 
 }  // namespace mcr

@@ -2,6 +2,7 @@
 // The file pipeline shared by the front ends: read passes -> reconstruction (optional
 // accumulation, the filter) -> write, with per-stage timings. One session keeps one
 // reconstruction (and its temporal history) across the frames of a sequence.
+#include <functional>
 #include <memory>
 #include <string>
 #include <utility>
@@ -15,6 +16,7 @@ namespace mcr {
 
 struct StageTimes {
   double read_ms = 0, filter_ms = 0, write_ms = 0;
+  std::vector<std::string> notes;  // the reconstruction's notes on this frame
   double total_ms() const { return read_ms + filter_ms + write_ms; }
 };
 
@@ -37,7 +39,25 @@ class DenoiseSession {
   StageTimes run(const std::string& input, const std::string& output, const ReadOptions& read,
                  const WriteOptions& write, const ExecOptions& exec);
 
+  // A sequence of run()s. pipelined: frame i+1 is read and frame i-1 written while frame i
+  // is filtered (three frames in memory instead of one; the same outputs, in order). An
+  // error stops the run after the write in flight has finished: every output written is
+  // complete. done(i, times) is called in order once job i is written (or filtered, for a
+  // job without output).
+  struct Job {
+    std::string input, output;  // output empty: filtered for the temporal history only
+    ReadOptions read;
+  };
+  void run_sequence(const std::vector<Job>& jobs, const WriteOptions& write, const ExecOptions& exec, bool pipelined,
+                    const std::function<void(std::size_t, const StageTimes&)>& done);
+
  private:
+  struct Filtered;
+  Frame read_checked(const std::string& input, const std::string& output, const ReadOptions& read,
+                     const WriteOptions& write) const;
+  void filter_into(Filtered& f, const WriteOptions& write, const ExecOptions& exec);
+  static void write_filtered(const std::string& output, const Filtered& f, const WriteOptions& write);
+
   Reconstruction reconstruction_;
 };
 

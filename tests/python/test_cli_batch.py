@@ -138,6 +138,33 @@ class BatchTest(unittest.TestCase):
         self.assertIn("1 written, 2 already done", proc.stderr)
         self.assertGreater(pixels(pattern.replace("####", "0003")).max(), 0)
 
+    def test_pipelined_run_equals_the_serial_one(self):
+        piped, serial = self.dir("piped"), self.dir("serial")
+        proc = self.bmfr(piped, "1-5", "--timings")
+        lines = [ln for ln in proc.stderr.splitlines() if "o_000" in ln and "filter " in ln]
+        self.assertEqual([ln.split("o_")[1][:4] for ln in lines], ["0001", "0002", "0003", "0004", "0005"])
+        self.bmfr(serial, "1-5", "--serial")
+        self.assertEqual(written(piped), written(serial))
+        for f in written(serial):
+            np.testing.assert_array_equal(pixels(os.path.join(piped, f)), pixels(os.path.join(serial, f)), f)
+
+    def test_a_bad_frame_stops_the_pipeline_with_every_earlier_output_complete(self):
+        src = self.sequence(5, 64, 48)
+        bad = src.replace("####", "0003")
+        with open(bad, "rb") as f:
+            data = f.read()
+        with open(bad, "wb") as f:
+            f.write(data[:len(data) // 2])
+        out = self.dir("out")
+        proc = tu.run_cli("denoise", src, "-o", os.path.join(out, "o_####.exr"), "-f", "box", "--frames", "1-5",
+                          check=False)
+        self.assertNotEqual(proc.returncode, 0)
+        self.assertIn("s_0003.exr", proc.stderr)
+        self.assertEqual(os.listdir(out).__len__(), len(written(out)))  # no temp file left
+        self.assertEqual(written(out), ["o_0001.exr", "o_0002.exr"])
+        for f in written(out):
+            self.assertEqual(pixels(os.path.join(out, f)).shape, (48, 64, 4))
+
     def test_plan_commands_give_the_single_run(self):
         single, farm = self.dir("single"), self.dir("farm")
         self.bmfr(single, "1-6")
