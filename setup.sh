@@ -20,6 +20,7 @@ PACKAGES=(
   pybind11-dev python3-pybind11 python3-numpy
   blender xvfb xauth
   clang libclang-rt-14-dev libfuzzer-14-dev llvm-14
+  slurm-wlm munge  # py_test_farm_slurm starts a one-node Slurm cluster
 )
 
 missing=()
