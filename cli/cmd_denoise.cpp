@@ -231,8 +231,8 @@ Run add_denoise(CLI::App& app) {
                "(others are redone); a temporal filter replays, without writing, only the done frames its history "
                "needs");
   app.add_option("--warmup", a->warmup,
-                 "temporal filters: run the history over the N frames before the first frame written, without "
-                 "writing them (a chunk of a split sequence then matches one run); default: from the first frame")
+                 "temporal filters: start the history N frames before the first of --frames, without writing "
+                 "them (a chunk of a split sequence then has the history a single run has, up to N frames back)")
       ->check(CLI::Range(0, 1000000));
   app.add_flag("--accumulate", a->accumulate,
                "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");

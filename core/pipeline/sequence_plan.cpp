@@ -24,13 +24,11 @@ std::vector<FrameJob> plan_sequence(const FrameList& frames, const std::vector<b
   if (first_todo == done.end()) return jobs;  // all done: nothing to replay
   const std::size_t k0 = std::size_t(first_todo - done.begin());
   const std::size_t k1 = f.size() - 1 - std::size_t(std::find(done.rbegin(), done.rend(), false) - done.rbegin());
-  if (warmup < 0) {
-    for (std::size_t i = 0; i < k0; ++i) jobs.push_back({f[i], false});
-  } else {
-    // The N frame numbers before the first one to write (consecutive: a temporal run's are).
-    for (long long g = (long long)f[k0] - warmup; g < f[k0]; ++g)
-      if (g >= (long long)std::numeric_limits<int>::min()) jobs.push_back({int(g), false});
-  }
+  // The warm-up frames before the list (consecutive: a temporal run's frames are), then every
+  // done frame up to the first one to write.
+  for (long long g = (long long)f[0] - std::max(0, warmup); g < f[0]; ++g)
+    if (g >= (long long)std::numeric_limits<int>::min()) jobs.push_back({int(g), false});
+  for (std::size_t i = 0; i < k0; ++i) jobs.push_back({f[i], false});
   for (std::size_t i = k0; i <= k1; ++i) jobs.push_back({f[i], !done[i]});
   return jobs;
 }

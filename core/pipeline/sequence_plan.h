@@ -15,12 +15,12 @@ struct FrameJob {
 };
 
 // frames: the run's frames; done[i]: frame i's output exists and is verified (--resume).
-// temporal: the reconstruction keeps history (frames must then be consecutive).
-// warmup: < 0 (not given): history from the run's own frames only, every done frame before
-// the first one to write is replayed; N >= 0: history from the N frames just before the first
-// frame to write, which may lie before the run's first frame (the chunk's warm-up).
+// temporal: the reconstruction keeps history (frames must then be consecutive). warmup: the
+// history starts that many frames before the run's first frame (frames before the list are
+// read, never written; < 0 is 0); with --resume every frame from there to the first one to
+// write is replayed, so a requeued chunk gives the same pixels as its first, whole run.
 // Not temporal: the frames not done, warmup ignored. Frames after the last one to write are
-// never read.
+// never read, and nothing at all when every frame is done.
 std::vector<FrameJob> plan_sequence(const FrameList& frames, const std::vector<bool>& done, bool temporal, int warmup);
 
 // A sequence split for a farm: consecutive runs of at most `chunk` frames of the list, each

@@ -108,9 +108,19 @@ class BatchTest(unittest.TestCase):
         for f in ("o_0001.exr", "o_0002.exr", "o_0004.exr", "o_0005.exr"):
             st = os.stat(os.path.join(out, f))
             self.assertEqual((st.st_ino, st.st_mtime_ns), (stats[f].st_ino, stats[f].st_mtime_ns), f)
+
+    def test_a_requeued_chunk_gives_its_first_runs_pixels(self):
+        """A chunk with warm-up that lost frames redoes them with the history of its whole run:
+        from the warm-up frames before the chunk, through its done frames."""
+        out = self.dir("out")
+        self.bmfr(out, "4-7", "--warmup", "3")
+        want = {f: pixels(os.path.join(out, f)) for f in written(out)}
         os.remove(os.path.join(out, "o_0006.exr"))
-        proc = self.bmfr(out, "1-6", "--resume", "--warmup", "2")  # history from frames 4-5 only
-        self.assertIn("1 written, 5 already done, 2 read for history only", proc.stderr)
+        os.remove(os.path.join(out, "o_0007.exr"))
+        proc = self.bmfr(out, "4-7", "--warmup", "3", "--resume")
+        self.assertIn("2 written, 2 already done, 5 read for history only", proc.stderr)  # 1-3 and 4-5
+        for f in ("o_0006.exr", "o_0007.exr"):
+            np.testing.assert_array_equal(pixels(os.path.join(out, f)), want[f], f)
 
     def test_resume_redoes_outputs_of_another_run(self):
         src = self.sequence(3)

@@ -335,10 +335,9 @@ class FarmSlurmTest(unittest.TestCase):
         self.assertIn("2 written, 2 already done", self.requeue("%s_3" % self.array))
         type(self).redone = True
 
-    @unittest.expectedFailure
     def test_4_redone_frames_equal_the_uninterrupted_run(self):
-        # Known: --resume starts the --warmup history 8 frames before the first frame it redoes
-        # (11: frames 3-10), not before the chunk's first frame (9: frames 1-8), so they drift.
+        # --resume replays the chunk's warm-up and its done frames: the redone frames get the
+        # history of the uninterrupted chunk (frames 1-10 for 11-12).
         if not getattr(type(self), "redone", False):
             self.skipTest("no requeue ran")
         self.assertSamePixels(os.path.join(self.tmp, "chunked"), (11, 12), "the uninterrupted chunk")
