@@ -411,6 +411,13 @@ class Session {
   int threads_;
 };
 
+// A sequence's output paths, one per frame.
+std::vector<std::string> outputs_of(const std::string& pattern, const mcr::FrameList& frames) {
+  std::vector<std::string> out;
+  for (int f : frames.frames()) out.push_back(mcr::sequence_path(pattern, f));
+  return out;
+}
+
 void raise_error(Errc code, const std::string& message) {
   py::object exc = py::reinterpret_borrow<py::object>(g_error_type)(py::str(message));
   exc.attr("kind") = mcr::errc_name(code);
@@ -552,8 +559,12 @@ PYBIND11_MODULE(mcrecon, m) {
          const std::string& filter,
          const py::dict& params, const std::optional<std::string>& layer, const py::dict& passes, int threads,
          const std::optional<std::function<void(std::int64_t, std::int64_t, std::string)>>& progress, const py::object& accumulate,
-         bool keep_components, const py::object& display) {
+         bool keep_components, const py::object& display, const py::object& warmup_arg) {
         const int first = int_from_py("first", first_arg), last = int_from_py("last", last_arg);
+        const int warmup = int_from_py("warmup", warmup_arg);
+        if (warmup < 0 || std::size_t(warmup) > mcr::kMaxFrames)
+          throw mcr::Error(Errc::InvalidArgument, "warmup " + std::to_string(warmup) + ": give 0 to " +
+                                                      std::to_string(mcr::kMaxFrames) + " frames");
         for (const std::string* p : {&input, &output})
           if (!mcr::is_sequence_pattern(*p))
             throw mcr::Error(Errc::InvalidArgument, std::string(p == &input ? "input" : "output") + " '" + *p +
@@ -571,6 +582,16 @@ PYBIND11_MODULE(mcrecon, m) {
         for (std::string& f : mcr::loose_pass_files(read_options(layer, passes))) inputs.push_back(std::move(f));
         mcr::check_sequence_outputs(output, frames, inputs);
         Session s(filter, params, threads, accumulate);
+        // --warmup: a temporal history starts `warmup` frames before `first` (read, not written).
+        std::vector<std::string> warm;
+        for (std::int64_t f = std::int64_t(first) - (s.temporal() ? warmup : 0); f < first; ++f) {
+          warm.push_back(mcr::sequence_path(input, int(f)));
+          std::error_code ec;
+          if (!std::filesystem::exists(warm.back(), ec))
+            throw mcr::Error(Errc::FileNotFound, "cannot read '" + warm.back() + "' (a warmup frame): no such file");
+        }
+        if (!warm.empty()) mcr::check_output_paths(outputs_of(output, frames), warm);
+        for (const std::string& w : warm) s.denoise_file(w, "", layer, passes, false, false, py::none());
         py::list outputs;
         for (std::int64_t f = first; f <= last; ++f) {
           const std::string out = mcr::sequence_path(output, int(f));
@@ -583,10 +604,11 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("input"), py::arg("output"), py::arg("first"), py::arg("last"), py::arg("filter"),
       py::arg("params") = py::dict(), py::arg("layer") = py::none(), py::arg("passes") = py::dict(),
       py::arg("threads") = 0, py::arg("progress") = py::none(), py::arg("accumulate") = false,
-      py::arg("keep_components") = false, py::arg("display") = py::none(),
+      py::arg("keep_components") = false, py::arg("display") = py::none(), py::arg("warmup") = 0,
       "Denoises frames first..last of a pattern (#### or %04d) in order with one Session (temporal history; "
-      "accumulate=True as --accumulate); progress(done, total, output) is called after each frame. Returns the "
-      "outputs written.");
+      "accumulate=True as --accumulate; warmup=N as --warmup: a temporal filter's history starts N frames "
+      "before first, read and not written); progress(done, total, output) is called after each frame. Returns "
+      "the outputs written.");
 
   m.def(
       "inactive_parameters",

@@ -187,6 +187,25 @@ def test_accumulate_matches_cli(tmp):
           "--accumulate` bit for bit")
 
 
+def test_sequence_warmup_matches_cli(tmp):
+    # warmup=N as --warmup N: frames 3-4 with 2 frames of history = frames 3-4 of a run over 1-4.
+    want = os.path.join(tmp, "wu_cli_####.exr")
+    cli("denoise", ANIM, "-o", want, "-f", "box", "--accumulate", "--frames", "3-4", "--warmup", "2")
+    cold = os.path.join(tmp, "wu_cold_####.exr")
+    mcrecon.denoise_sequence(ANIM, cold, 3, 4, "box", accumulate=True)
+    outs = mcrecon.denoise_sequence(ANIM, os.path.join(tmp, "wu_py_####.exr"), 3, 4, "box", accumulate=True, warmup=2)
+    for f, out in zip((3, 4), outs):
+        assert same_bits(read_channels(out)[1], read_channels(frame_path(want, f))[1]), f"warmup=2 frame {f} differs"
+    assert not same_bits(read_channels(frame_path(cold, 3))[1], read_channels(frame_path(want, 3))[1]), \
+        "warmup=2 gives the cold start's pixels"
+    try:
+        mcrecon.denoise_sequence(ANIM, os.path.join(tmp, "wu_bad_####.exr"), 1, 2, "box", accumulate=True, warmup=1)
+        raise AssertionError("a warmup frame before the sequence was accepted")
+    except mcrecon.Error as e:
+        assert "anim_1spp_0000.exr" in str(e) and "warmup" in str(e), str(e)
+    print("denoise_sequence(warmup=2) matches `mcrecon denoise --warmup 2` bit for bit")
+
+
 def test_needs_match_info_and_settings(tmp):
     # `mcrecon info` says which filters can run with their defaults: needs() of the defaults. A
     # colour-only file lacks what some filters require; its sample count is a pass the defaults
@@ -350,6 +369,7 @@ if __name__ == "__main__":
         test_arrays_match_cli(tmp)
         test_auto_reports_its_choice(tmp)
         test_accumulate_matches_cli(tmp)
+        test_sequence_warmup_matches_cli(tmp)
         test_needs_match_info_and_settings(tmp)
         test_notes_hold_unused_settings(tmp)
         test_two_threads_filter_at_once()
