@@ -6,6 +6,9 @@
 //
 //   mcrecon_bench_sequence [--frames N] [--repeat N] [--filter NAME] [--keep DIR]
 //
+// --keep DIR keeps the frames (in_0001.exr ...) and uses any already there: a sequence made
+// elsewhere (e.g. with oiiotool, with other channel types) can be measured the same way.
+//
 // Then the output compressions' cost: one filtered frame written with each (best of `repeat`),
 // milliseconds and megabytes, so `--compression` can be chosen knowing what it costs.
 //
@@ -74,7 +77,7 @@ int main(int argc, char** argv) {
   std::fprintf(stderr, "making %d frames of 1280x720 in %s\n", frames, dir.c_str());
   for (int f = 1; f <= frames; ++f)
     if (!fs::exists(sequence_path(input, f))) make_frame(sequence_path(anim, (f - 1) % 16 + 1), sequence_path(input, f), f);
-  std::printf("sequence: %d frames 1280x720, 28 channels, half zip, %.1f MB per frame; filter %s; load before: %s\n",
+  std::printf("sequence: %d frames 1280x720, 28 channels, zip, %.1f MB per frame; filter %s; load before: %s\n",
               frames, double(fs::file_size(sequence_path(input, 1))) / 1e6, filter.c_str(), load_average().c_str());
   std::vector<DenoiseSession::Job> jobs;
   for (int f = 1; f <= frames; ++f) jobs.push_back({sequence_path(input, f), sequence_path(output, f), ReadOptions{}});

@@ -4,9 +4,11 @@
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
 #include <OpenImageIO/imageio.h>
+#include <Imath/half.h>
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <set>
 
@@ -24,14 +26,44 @@ using namespace OIIO;
 
 namespace {
 
-// All channels of every part (subimage) as interleaved float.
+// All channels of every part (subimage), interleaved: as float, or, for a one-part file whose
+// channels are half or float (Blender's half EXRs keep depth, normal, position and motion in
+// float), in the file's own types, converted only for the channels a pass takes: half the
+// memory traffic of a wide render, and no conversion of the channels no filter reads.
 struct RawImage {
   int width = 0, height = 0;
   PixelWindow window;
   std::vector<std::string> names;
   std::vector<float> pixels;
+  // The native form, used instead of pixels when not empty: packed pixels of `stride` bytes,
+  // channel c at byte offset[c], half when is_half[c], else float.
+  std::vector<unsigned char> native;
+  std::vector<std::size_t> offset;
+  std::vector<char> is_half;
+  std::size_t stride = 0;
   std::shared_ptr<DeepSamples> deep;
+
+  float value(std::size_t px, std::size_t c) const {
+    if (native.empty()) return pixels[px * names.size() + c];
+    const unsigned char* p = native.data() + px * stride + offset[c];
+    if (is_half[c]) {
+      Imath::half h;
+      std::memcpy(&h, p, sizeof h);
+      return float(h);
+    }
+    float f;
+    std::memcpy(&f, p, sizeof f);
+    return f;
+  }
 };
+
+bool half_or_float(const ImageSpec& spec) {
+  for (int c = 0; c < spec.nchannels; ++c) {
+    const TypeDesc t = spec.channelformat(c);
+    if (t != TypeHalf && t != TypeFloat) return false;
+  }
+  return true;
+}
 
 std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec) {
   auto deep = std::make_shared<DeepSamples>();
@@ -102,7 +134,7 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
   std::vector<std::vector<float>> parts;
   std::vector<int> widths;
   for (int part = 0; in.seek_subimage(part, 0); ++part) {
-    const ImageSpec& spec = in.spec();
+    const ImageSpec spec = in.spec();  // a copy: the probe below seeks
     if (part > 0) {
       if (spec.deep) continue;  // only part 0 may be deep (read as the per-sample buffer)
       if (spec.width != raw.width || spec.height != raw.height || spec.x != raw.window.x || spec.y != raw.window.y)
@@ -119,6 +151,25 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
         throw Error(Errc::ReadFailed, "'" + path + "' " + part_label(spec, part) + " repeats channel '" + n +
                                           "' and has no part name to tell it apart");
       raw.names.push_back(taken ? part_name + "." + n : n);
+    }
+    bool only_part = false;
+    if (part == 0 && half_or_float(spec)) {
+      only_part = !in.seek_subimage(1, 0);
+      if (only_part) (void)in.geterror();  // the probe's "no such part" is not this read's error
+      if (!in.seek_subimage(0, 0))
+        throw Error(Errc::ReadFailed, "cannot read '" + path + "' part 0 again: " + in.geterror());
+    }
+    if (only_part) {
+      for (int c = 0; c < spec.nchannels; ++c) {
+        raw.offset.push_back(raw.stride);
+        raw.is_half.push_back(spec.channelformat(c) == TypeHalf);
+        raw.stride += spec.channelformat(c).size();
+      }
+      raw.native.resize(std::size_t(spec.width) * spec.height * raw.stride);
+      if (!in.read_image(0, 0, 0, spec.nchannels, TypeUnknown, raw.native.data()))
+        throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' " + part_label(spec, part) +
+                                          " (truncated or corrupt?): " + in.geterror());
+      return;
     }
     parts.emplace_back(std::size_t(spec.width) * spec.height * spec.nchannels);
     widths.push_back(spec.nchannels);
@@ -176,7 +227,7 @@ Pass make_pass(const RawImage& raw, const std::string& path, const std::string& 
   p.source = path;
   p.space = m.space;
   p.priority = m.priority;
-  const int nc = int(m.indices.size()), nin = int(raw.names.size());
+  const int nc = int(m.indices.size());
   for (int i : m.indices) p.channels.push_back(raw.names[std::size_t(i)]);
   p.image = Image(raw.width, raw.height, nc);
   float* dst = p.image.data();
@@ -184,7 +235,7 @@ Pass make_pass(const RawImage& raw, const std::string& path, const std::string& 
   const std::size_t w = std::size_t(raw.width);
   parallel_rows(0, raw.height, 0, [&](int y) {
     for (std::size_t px = std::size_t(y) * w; px < std::size_t(y + 1) * w; ++px)
-      for (int c = 0; c < nc; ++c) dst[px * nc + c] = raw.pixels[px * nin + std::size_t(m.indices[std::size_t(c)])];
+      for (int c = 0; c < nc; ++c) dst[px * nc + c] = raw.value(px, std::size_t(m.indices[std::size_t(c)]));
   });
   return p;
 }

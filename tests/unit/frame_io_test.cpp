@@ -1,6 +1,7 @@
 // Reading frames (layers, roles, overrides, deep files), writing results, output
 // path checks and sequence helpers, on EXRs written here with OpenImageIO.
 #include <OpenImageIO/deepdata.h>
+#include <Imath/half.h>
 #include <OpenImageIO/imageio.h>
 #include <gtest/gtest.h>
 #include <unistd.h>
@@ -193,6 +194,48 @@ TEST_F(FrameIoTest, PlainRgbazFile) {
   EXPECT_EQ(f.get(Role::Depth).channels, (Names{"Z"}));
   EXPECT_EQ(f.image(Role::Depth).at(4, 1, 0), written(ch, "Z", 4, 1));
   EXPECT_EQ(f.image(Role::Colour).at(4, 1, 1), written(ch, "G", 4, 1));
+}
+
+// A one-part file with every channel half is read as half and converted per pass (the wide
+// render's fast path): the same values as the float path gives, the file's own halves, for
+// passes and for the channels --keep-passes carries; a file with one float channel among
+// halves takes the float path, with the same result.
+TEST_F(FrameIoTest, AllHalfFilesReadTheirHalvesExactly) {
+  const Names ch = {"R", "G", "B", "A", "N.X", "N.Y", "N.Z", "extra.V"};
+  const int w = 7, h = 5;
+  auto fn = [](int x, int y, int c) { return value_of(x, y, c) * 1.37f + 0.001f; };  // not exact in half
+  for (const bool mixed : {false, true}) {
+    OIIO::ImageSpec spec(w, h, int(ch.size()), OIIO::TypeHalf);
+    spec.channelnames = ch;
+    spec.alpha_channel = 3;
+    if (mixed) {
+      spec.channelformats.assign(ch.size(), OIIO::TypeHalf);
+      spec.channelformats.back() = OIIO::TypeFloat;
+    }
+    std::vector<float> px(std::size_t(w) * h * ch.size());
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < int(ch.size()); ++c) px[(std::size_t(y) * w + x) * ch.size() + std::size_t(c)] = fn(x, y, c);
+    const std::string file = path(mixed ? "mixed.exr" : "half.exr");
+    auto out = OIIO::ImageOutput::create(file);
+    ASSERT_TRUE(out && out->open(file, spec)) << OIIO::geterror();
+    ASSERT_TRUE(out->write_image(OIIO::TypeFloat, px.data())) << out->geterror();
+    out->close();
+    ReadOptions keep;
+    keep.keep_extra = true;
+    const Frame f = read_frame(file, keep);
+    const std::map<std::string, std::vector<float>> all = read_all(file);  // OIIO's own float conversion
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t i = std::size_t(y) * w + std::size_t(x);
+        EXPECT_EQ(f.image(Role::Colour).at(x, y, 1), all.at("G")[i]) << mixed;
+        EXPECT_EQ(f.image(Role::Colour).at(x, y, 1), float(Imath::half(fn(x, y, 1)))) << mixed;
+        EXPECT_NE(f.image(Role::Colour).at(x, y, 1), fn(x, y, 1)) << "the test's values must not be exact in half";
+        EXPECT_EQ(f.image(Role::Normal).at(x, y, 2), all.at("N.Z")[i]) << mixed;
+        ASSERT_EQ(f.extra.size(), 1u) << mixed;
+        EXPECT_EQ(f.extra[0].image.at(x, y, 0), all.at("extra.V")[i]) << mixed;
+      }
+  }
 }
 
 TEST_F(FrameIoTest, PlainFileWithShortFeatureNames) {
