@@ -5,6 +5,8 @@
 
 #include "commands.h"
 #include "io/sequence.h"
+#include "pipeline/denoise_session.h"
+#include "pipeline/reconstruction.h"
 #include "pipeline/sequence_plan.h"
 #include "util/error.h"
 
@@ -37,6 +39,20 @@ int run_plan(const PlanArgs& a) {
     for (const char* own : {"--frames", "--warmup", "--resume"})
       if (arg == own || arg.rfind(std::string(own) + "=", 0) == 0)
         throw Error(Errc::InvalidArgument, "plan: '" + arg + "' after --: plan gives each chunk its own " + own);
+  // The filter and its settings checked here, before a farm queues a task that would fail.
+  std::string filter;
+  std::vector<std::pair<std::string, std::string>> sets;
+  for (std::size_t i = 1; i + 1 < a.command.size(); ++i) {
+    const std::string& arg = a.command[i];
+    if (arg == "-f" || arg == "--filter") filter = a.command[i + 1];
+    if (arg == "-s" || arg == "--set") sets.push_back(parse_key_value(a.command[i + 1], "--set"));
+  }
+  for (const std::string& arg : a.command) {
+    if (arg.rfind("--filter=", 0) == 0) filter = arg.substr(9);
+    if (arg.rfind("--set=", 0) == 0) sets.push_back(parse_key_value(arg.substr(6), "--set"));
+  }
+  if (filter.empty()) throw Error(Errc::InvalidArgument, "plan: the denoise command after -- names no filter (-f NAME)");
+  make_committed_filter(filter, sets);
   const FrameList frames = parse_frame_list(a.frames);
   const std::vector<Chunk> chunks = plan_chunks(frames, a.chunk, a.warmup);
   if (a.task < 0 || a.task > int(chunks.size()))

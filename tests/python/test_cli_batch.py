@@ -194,6 +194,12 @@ class BatchTest(unittest.TestCase):
         proc = tu.run_cli("plan", "--frames", "1-6", "--chunk", "2", "--", *cmd, "--resume", check=False)
         self.assertEqual(proc.returncode, 2)
         self.assertIn("--resume", proc.stderr)
+        # A filter or setting the task would refuse is refused before anything is queued.
+        for bad, named in ((["-f", "nosuch"], "nosuch"), (["-f", "bmfr", "--set", "block_size=-3"], "block_size")):
+            proc = tu.run_cli("plan", "--frames", "1-6", "--chunk", "2", "--", "denoise", ANIM, "-o",
+                              os.path.join(farm, "x_####.exr"), *bad, check=False)
+            self.assertEqual(proc.returncode, 2, bad)
+            self.assertIn(named, proc.stderr)
 
 
 if __name__ == "__main__":
