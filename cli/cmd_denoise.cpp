@@ -109,7 +109,6 @@ int run_denoise(const DenoiseArgs& a) {
     inputs.push_back(h);
   };
   for (int f : frames.frames()) need_input(f, "");
-  const int warmup = temporal ? a.warmup : -1;
   for (std::string& f : loose_pass_files(ro)) inputs.push_back(std::move(f));  // --pass normal=n.exr
   if (seq) check_sequence_outputs(a.output, frames, inputs);  // every frame its own file
   else check_output_paths({a.output}, inputs);
@@ -142,16 +141,13 @@ int run_denoise(const DenoiseArgs& a) {
       }
     }
   }
-  const std::vector<FrameJob> jobs = plan_sequence(frames, done, temporal, warmup);
+  const std::vector<FrameJob> jobs = plan_sequence(frames, done, temporal, a.warmup);
   // Warm-up frames before the list's first: they must exist, and no output may fall on one.
   const std::size_t listed = inputs.size();
   for (const FrameJob& j : jobs)
     if (j.frame < frames.first()) need_input(j.frame, " (a --warmup " + std::to_string(a.warmup) + " frame)");
-  if (inputs.size() > listed) {
-    std::vector<std::string> outputs;
-    for (int f : frames.frames()) outputs.push_back(output_of(f));
-    check_output_paths(outputs, std::vector<std::string>(inputs.begin() + long(listed), inputs.end()));
-  }
+  if (inputs.size() > listed)
+    check_sequence_outputs(a.output, frames, std::vector<std::string>(inputs.begin() + long(listed), inputs.end()));
   const int skipped = int(std::count(done.begin(), done.end(), true));
   Progress progress("denoise " + a.filter, int(jobs.size()));
   if (seq && skipped)

@@ -21,6 +21,7 @@
 #include "io/frame_writer.h"
 #include "io/output_guard.h"
 #include "io/sequence.h"
+#include "pipeline/sequence_plan.h"
 #include "pipeline/denoise_session.h"
 #include "pipeline/filter_catalog.h"
 #include "util/error.h"
@@ -411,13 +412,6 @@ class Session {
   int threads_;
 };
 
-// A sequence's output paths, one per frame.
-std::vector<std::string> outputs_of(const std::string& pattern, const mcr::FrameList& frames) {
-  std::vector<std::string> out;
-  for (int f : frames.frames()) out.push_back(mcr::sequence_path(pattern, f));
-  return out;
-}
-
 void raise_error(Errc code, const std::string& message) {
   py::object exc = py::reinterpret_borrow<py::object>(g_error_type)(py::str(message));
   exc.attr("kind") = mcr::errc_name(code);
@@ -582,15 +576,16 @@ PYBIND11_MODULE(mcrecon, m) {
         for (std::string& f : mcr::loose_pass_files(read_options(layer, passes))) inputs.push_back(std::move(f));
         mcr::check_sequence_outputs(output, frames, inputs);
         Session s(filter, params, threads, accumulate);
-        // --warmup: a temporal history starts `warmup` frames before `first` (read, not written).
+        // warmup as --warmup: the frames before `first` the plan reads and does not write.
         std::vector<std::string> warm;
-        for (std::int64_t f = std::int64_t(first) - (s.temporal() ? warmup : 0); f < first; ++f) {
-          warm.push_back(mcr::sequence_path(input, int(f)));
+        for (const mcr::FrameJob& j : mcr::plan_sequence(frames, std::vector<bool>(frames.size(), false), s.temporal(), warmup)) {
+          if (j.write) break;
+          warm.push_back(mcr::sequence_path(input, j.frame));
           std::error_code ec;
           if (!std::filesystem::exists(warm.back(), ec))
             throw mcr::Error(Errc::FileNotFound, "cannot read '" + warm.back() + "' (a warmup frame): no such file");
         }
-        if (!warm.empty()) mcr::check_output_paths(outputs_of(output, frames), warm);
+        if (!warm.empty()) mcr::check_sequence_outputs(output, frames, warm);
         for (const std::string& w : warm) s.denoise_file(w, "", layer, passes, false, false, py::none());
         py::list outputs;
         for (std::int64_t f = first; f <= last; ++f) {

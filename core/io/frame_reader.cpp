@@ -42,20 +42,20 @@ struct RawImage {
   std::vector<char> is_half;
   std::size_t stride = 0;
   std::shared_ptr<DeepSamples> deep;
-
-  float value(std::size_t px, std::size_t c) const {
-    if (native.empty()) return pixels[px * names.size() + c];
-    const unsigned char* p = native.data() + px * stride + offset[c];
-    if (is_half[c]) {
-      Imath::half h;
-      std::memcpy(&h, p, sizeof h);
-      return float(h);
-    }
-    float f;
-    std::memcpy(&f, p, sizeof f);
-    return f;
-  }
 };
+
+// Native channel c of pixel px as float.
+inline float native_value(const RawImage& raw, std::size_t px, std::size_t c) {
+  const unsigned char* p = raw.native.data() + px * raw.stride + raw.offset[c];
+  if (raw.is_half[c]) {
+    Imath::half h;
+    std::memcpy(&h, p, sizeof h);
+    return float(h);
+  }
+  float f;
+  std::memcpy(&f, p, sizeof f);
+  return f;
+}
 
 bool half_or_float(const ImageSpec& spec) {
   for (int c = 0; c < spec.nchannels; ++c) {
@@ -233,9 +233,13 @@ Pass make_pass(const RawImage& raw, const std::string& path, const std::string& 
   float* dst = p.image.data();
   // Rows in parallel: a strided gather out of a wide file (28 channels, 720p) is memory-bound.
   const std::size_t w = std::size_t(raw.width);
+  const std::size_t nin = raw.names.size();
   parallel_rows(0, raw.height, 0, [&](int y) {
     for (std::size_t px = std::size_t(y) * w; px < std::size_t(y + 1) * w; ++px)
-      for (int c = 0; c < nc; ++c) dst[px * nc + c] = raw.value(px, std::size_t(m.indices[std::size_t(c)]));
+      for (int c = 0; c < nc; ++c) {
+        const std::size_t ch = std::size_t(m.indices[std::size_t(c)]);
+        dst[px * nc + c] = raw.native.empty() ? raw.pixels[px * nin + ch] : native_value(raw, px, ch);
+      }
   });
   return p;
 }

@@ -56,20 +56,22 @@ std::string input_stamp(const std::string& input) {
 
 std::string stale_output_reason(const std::string& output, const std::string& filter, const std::string& parameters,
                                 const std::string& input) {
-  const std::string unreadable = incomplete_file_reason(output);
-  if (!unreadable.empty()) return "unreadable: " + unreadable;
-  auto in = OIIO::ImageInput::open(output);
-  if (!in) return "unreadable: " + OIIO::geterror();
-  const OIIO::ImageSpec& spec = in->spec();
-  const std::string had_filter = spec.get_string_attribute("mcreconFilter");
+  // The header first: an output of another run is redone without decoding its pixels.
+  std::string had_filter, had_params, had_input;
+  {
+    auto in = OIIO::ImageInput::open(output);
+    if (!in) return "unreadable: " + OIIO::geterror();
+    had_filter = in->spec().get_string_attribute("mcreconFilter");
+    had_params = in->spec().get_string_attribute("mcreconParameters");
+    had_input = in->spec().get_string_attribute("mcreconInput");
+  }
   if (had_filter.empty()) return "not an mcrecon output (no mcreconFilter in its header)";
   if (had_filter != filter) return "made by " + had_filter + ", this run is " + filter;
-  const std::string had_params = spec.get_string_attribute("mcreconParameters");
   if (had_params != parameters) return "made with other parameters (" + had_params + ")";
-  const std::string had_input = spec.get_string_attribute("mcreconInput");
   const std::string now = input_stamp(input);
   if (had_input != now) return "made from another input (" + (had_input.empty() ? "not recorded" : had_input) + ", now " + now + ")";
-  return "";
+  const std::string unreadable = incomplete_file_reason(output);
+  return unreadable.empty() ? "" : "unreadable: " + unreadable;
 }
 
 }  // namespace mcr
