@@ -1,0 +1,74 @@
+#pragma once
+// Light-field samples (Yan et al. 2015): per pixel l x l samples of f(x, y), x the pixel
+// (receiver) and y a 2D coordinate on the light, the lens or the v-plane, with the pixel's
+// slope bounds. Decoded from / encoded to a deep EXR (README: the light-field convention).
+//
+// One convention for the three effects (what the filters rely on): a sample taken at pixel
+// x' with coordinate y' carries the value that pixel x would see at
+//     y = y' - (x - x') / s            (per axis, x in "x units", s the local slope)
+// where x units are world units along the receiver for soft shadows and indirect light
+// (screen pixels per x unit in e1, e2) and pixels for depth of field (e1 = (1,0), e2 = (0,1)):
+//   soft shadows:  s = d1/d2 - 1   (d1: light to receiver, d2: light to occluder), y on the
+//                  light in world units, Gaussian light of standard deviation sigma_y;
+//   depth of field: s = -c, c the circle of confusion radius in pixels per unit of lens
+//                  coordinate (signed: negative behind the focus plane), y on the lens,
+//                  Gaussian aperture of standard deviation sigma_y;
+//   indirect light: s = z, the reflector's distance from the receiver along the normal, y on
+//                  the v-plane at unit distance (tangent of the direction), values already
+//                  weighted by the diffuse transfer over the sampling pdf (their plain mean is
+//                  the pixel), a box over y: the v-plane truncation [-L, L]^2; sigma_y = 2 /
+//                  Omega_v^max (about 0.71) sets only the spatial width.
+// Spatial standard deviation (x units) from the bounds, eq. 4: sigma_x = sigma_y * smin * smax /
+// (smax - smin); the shear (primal, this convention): eta = (1/smin + 1/smax) / 2, the weight of
+// a sample for pixel x being w_x(x' - x) w_y(y' + eta (x' - x)) per axis.
+// A pixel's bounds [smin, smax] span the slopes its samples saw; smin = smax = 0 says
+// nothing to shear (unoccluded, in focus, no reflector).
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "image/deep.h"
+
+namespace mcr {
+
+enum class LightFieldEffect { SoftShadows, Dof, Gi };
+const char* effect_name(LightFieldEffect e);  // "soft_shadows", "dof", "gi"
+
+struct LightField {
+  LightFieldEffect effect = LightFieldEffect::SoftShadows;
+  int width = 0, height = 0;
+  int l = 0;            // samples per axis: every pixel holds l*l samples
+  float y_range = 1;    // L: y sampled over [-L, L]^2 (uniform jittered strata)
+  float sigma_y = 0.5;  // Gaussian standard deviation over y (soft shadows, dof); gi: 2 / Omega_v^max
+
+  // Per sample, index pixel * l*l + k (pixel = y * width + x; k in any order).
+  std::vector<float> r, g, b;   // f(x, y): the sample's value, not weighted by the light/lens
+  std::vector<float> y1, y2;    // the sample's coordinate on the light / lens / v-plane
+
+  // Per pixel.
+  std::vector<float> smin, smax;          // slope bounds (both 0: nothing to shear)
+  std::vector<float> e1x, e1y, e2x, e2y;  // screen displacement in pixels per x unit along x1, x2
+  std::vector<float> depth;               // receiver depth along the view ray (first hit)
+  std::vector<float> px, py, pz;          // receiver world position (empty when the file has none)
+  std::vector<float> nx, ny, nz;          // receiver world normal, unit (empty when absent)
+
+  int spp() const { return l * l; }
+  std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
+  std::size_t samples() const { return pixels() * std::size_t(spp()); }
+  bool has_geometry() const { return !px.empty() && !nx.empty(); }
+  // Allocates every array for width x height x l*l (geometry too when `geometry`).
+  void resize(int w, int h, int l_, bool geometry);
+};
+
+// The deep EXR form: per-sample channels R G B lf.y1 lf.y2, and per-pixel values repeated on
+// each sample: lf.smin lf.smax lf.e1x lf.e1y lf.e2x lf.e2y Z, optionally P.X P.Y P.Z N.X N.Y N.Z;
+// header attributes mcrecon:lightfield (effect), mcrecon:lf_l, mcrecon:lf_y_range,
+// mcrecon:lf_sigma_y.
+bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield
+// Throws Error (BadInput / MissingPass) naming `path` and what is wrong: a missing channel or
+// attribute, a pixel without exactly l*l samples, a non-finite or out-of-range coordinate, a
+// non-finite slope or axis, l outside 1..64. Non-finite values become 0 (and are counted).
+LightField decode_lightfield(const DeepSamples& deep, const std::string& path, std::size_t* nonfinite_values = nullptr);
+DeepSamples encode_lightfield(const LightField& lf);
+
+}  // namespace mcr
