@@ -1,0 +1,219 @@
+#include "image/lightfield.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <sstream>
+
+#include "util/error.h"
+
+namespace mcr {
+
+const char* effect_name(LightFieldEffect e) {
+  switch (e) {
+    case LightFieldEffect::SoftShadows: return "soft_shadows";
+    case LightFieldEffect::Dof: return "dof";
+    case LightFieldEffect::Gi: return "gi";
+  }
+  return "?";
+}
+
+void LightField::resize(int w, int h, int l_, bool geometry) {
+  width = w;
+  height = h;
+  l = l_;
+  const std::size_t n = samples(), p = pixels();
+  for (auto* v : {&r, &g, &b, &y1, &y2}) v->assign(n, 0.f);
+  for (auto* v : {&smin, &smax, &e1x, &e1y, &e2x, &e2y, &depth}) v->assign(p, 0.f);
+  for (auto* v : {&px, &py, &pz, &nx, &ny, &nz}) v->assign(geometry ? p : 0, 0.f);
+}
+
+bool is_lightfield(const DeepSamples& deep) { return deep.attributes.count("mcrecon:lightfield") != 0; }
+
+namespace {
+
+const char* const kSampleChannels[] = {"R", "G", "B", "lf.y1", "lf.y2"};
+const char* const kPixelChannels[] = {"lf.smin", "lf.smax", "lf.e1x", "lf.e1y", "lf.e2x", "lf.e2y", "Z"};
+const char* const kGeometryChannels[] = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z"};
+
+std::string at(int x, int y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
+
+const std::string& attribute(const DeepSamples& deep, const std::string& name, const std::string& path) {
+  auto it = deep.attributes.find(name);
+  if (it == deep.attributes.end())
+    throw Error(Errc::MissingPass, "'" + path + "': light-field header attribute '" + name +
+                                       "' is missing (README: the light-field convention)");
+  return it->second;
+}
+
+double number(const DeepSamples& deep, const std::string& name, const std::string& path, double lo, double hi) {
+  const std::string& text = attribute(deep, name, path);
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0' || !std::isfinite(v) || v < lo || v > hi) {
+    std::ostringstream os;
+    os << "'" << path << "': light-field attribute " << name << " = '" << text << "' is not a number in [" << lo
+       << ", " << hi << "]";
+    throw Error(Errc::ReadFailed, os.str());
+  }
+  return v;
+}
+
+LightFieldEffect parse_effect(const DeepSamples& deep, const std::string& path) {
+  const std::string& e = attribute(deep, "mcrecon:lightfield", path);
+  for (LightFieldEffect k : {LightFieldEffect::SoftShadows, LightFieldEffect::Dof, LightFieldEffect::Gi})
+    if (e == effect_name(k)) return k;
+  throw Error(Errc::ReadFailed, "'" + path + "': mcrecon:lightfield = '" + e +
+                                    "' is not an effect (soft_shadows, dof, gi)");
+}
+
+int require_channel(const DeepSamples& deep, const char* name, const std::string& path, const char* what) {
+  const int c = deep.channel(name);
+  if (c < 0)
+    throw Error(Errc::MissingPass, "'" + path + "': light field lacks the per-sample channel '" + name + "' (" +
+                                       what + "; README: the light-field convention)");
+  return c;
+}
+
+const char* channel_meaning(const std::string& name) {
+  if (name == "lf.y1" || name == "lf.y2") return "the sample's coordinate on the light, lens or v-plane";
+  if (name == "lf.smin" || name == "lf.smax") return "the pixel's slope bounds";
+  if (name.rfind("lf.e", 0) == 0) return "the screen axes of the pixel's filter";
+  if (name == "Z") return "the receiver's depth";
+  return "the sample's value";
+}
+
+}  // namespace
+
+LightField decode_lightfield(const DeepSamples& deep, const std::string& path, std::size_t* nonfinite_values) {
+  LightField lf;
+  lf.effect = parse_effect(deep, path);
+  const int l = int(number(deep, "mcrecon:lf_l", path, 1, 64));
+  if (double(l) != number(deep, "mcrecon:lf_l", path, 1, 64))
+    throw Error(Errc::ReadFailed, "'" + path + "': mcrecon:lf_l = '" + attribute(deep, "mcrecon:lf_l", path) +
+                                      "' is not a whole number of samples per axis");
+  lf.y_range = float(number(deep, "mcrecon:lf_y_range", path, 1e-6, 1e6));
+  lf.sigma_y = float(number(deep, "mcrecon:lf_sigma_y", path, 1e-6, 1e6));
+  if (deep.width <= 0 || deep.height <= 0 || deep.offsets.size() != std::size_t(deep.width) * deep.height + 1)
+    throw Error(Errc::ReadFailed, "'" + path + "': the deep buffer holds no pixels");
+
+  int sc[5], pc[7], gc[6];
+  for (int i = 0; i < 5; ++i) sc[i] = require_channel(deep, kSampleChannels[i], path, channel_meaning(kSampleChannels[i]));
+  for (int i = 0; i < 7; ++i) pc[i] = require_channel(deep, kPixelChannels[i], path, channel_meaning(kPixelChannels[i]));
+  int present = 0;
+  for (int i = 0; i < 6; ++i) present += (gc[i] = deep.channel(kGeometryChannels[i])) >= 0;
+  if (present != 0 && present != 6)
+    throw Error(Errc::MissingPass, "'" + path + "': light field has only some of P.X P.Y P.Z N.X N.Y N.Z (all six or none)");
+  const std::uint64_t spp = std::uint64_t(l) * std::uint64_t(l);
+  if (deep.total_samples() != spp * std::uint64_t(deep.width) * std::uint64_t(deep.height)) {
+    // Name the first pixel that breaks the rule: more use than a total.
+    for (int y = 0; y < deep.height; ++y)
+      for (int x = 0; x < deep.width; ++x)
+        if (deep.samples(x, y) != spp)
+          throw Error(Errc::ReadFailed, "'" + path + "': " + at(x, y) + " has " + std::to_string(deep.samples(x, y)) +
+                                            " samples; mcrecon:lf_l = " + std::to_string(l) + " needs exactly " +
+                                            std::to_string(spp) + " in every pixel");
+  }
+  lf.resize(deep.width, deep.height, l, present == 6);
+
+  std::size_t repaired = 0;
+  const float ylim = lf.y_range * (1 + 1e-4f);
+  std::vector<float*> pixel_dst = {lf.smin.data(), lf.smax.data(), lf.e1x.data(), lf.e1y.data(),
+                                   lf.e2x.data(),  lf.e2y.data(),  lf.depth.data()};
+  std::vector<float*> geo_dst = {lf.px.data(), lf.py.data(), lf.pz.data(), lf.nx.data(), lf.ny.data(), lf.nz.data()};
+  for (int y = 0; y < deep.height; ++y)
+    for (int x = 0; x < deep.width; ++x) {
+      const std::size_t p = std::size_t(y) * deep.width + x;
+      const std::uint64_t s0 = deep.first(x, y);
+      // Coordinates: a sample without a place on the light cannot be filtered; refused.
+      for (std::uint64_t k = 0; k < spp; ++k) {
+        const float a = deep.values[sc[3]][s0 + k], c = deep.values[sc[4]][s0 + k];
+        if (!std::isfinite(a) || !std::isfinite(c) || std::fabs(a) > ylim || std::fabs(c) > ylim) {
+          std::ostringstream os;
+          os << "'" << path << "': " << at(x, y) << " sample " << k << " has coordinate (lf.y1, lf.y2) = (" << a << ", "
+             << c << "), outside [-" << lf.y_range << ", " << lf.y_range << "] (mcrecon:lf_y_range)";
+          throw Error(Errc::ReadFailed, os.str());
+        }
+        lf.y1[p * spp + k] = a;
+        lf.y2[p * spp + k] = c;
+      }
+      // Values: a non-finite one takes its pixel's finite mean (0 if none), counted.
+      for (int ch = 0; ch < 3; ++ch) {
+        std::vector<float>& dst = ch == 0 ? lf.r : ch == 1 ? lf.g : lf.b;
+        double sum = 0;
+        std::uint64_t n = 0;
+        for (std::uint64_t k = 0; k < spp; ++k) {
+          const float v = deep.values[sc[ch]][s0 + k];
+          if (std::isfinite(v)) sum += v, ++n;
+        }
+        const float mean = n ? float(sum / double(n)) : 0.f;
+        for (std::uint64_t k = 0; k < spp; ++k) {
+          const float v = deep.values[sc[ch]][s0 + k];
+          dst[p * spp + k] = std::isfinite(v) ? v : (++repaired, mean);
+        }
+      }
+      // Per-pixel values are the first sample's; slopes and axes must be finite.
+      for (int i = 0; i < 7; ++i) {
+        const float v = deep.values[pc[i]][s0];
+        if (!std::isfinite(v)) {
+          if (i == 6) {  // a depth is only used for reports
+            pixel_dst[i][p] = 0, ++repaired;
+            continue;
+          }
+          throw Error(Errc::ReadFailed, "'" + path + "': " + at(x, y) + " has a non-finite " + kPixelChannels[i] +
+                                            " (" + channel_meaning(kPixelChannels[i]) + ")");
+        }
+        pixel_dst[i][p] = v;
+      }
+      if (lf.smin[p] > lf.smax[p]) {
+        std::ostringstream os;
+        os << "'" << path << "': " << at(x, y) << " has lf.smin = " << lf.smin[p] << " above lf.smax = " << lf.smax[p];
+        throw Error(Errc::ReadFailed, os.str());
+      }
+      if (present == 6) {
+        for (int i = 0; i < 6; ++i) {
+          const float v = deep.values[gc[i]][s0];
+          geo_dst[i][p] = std::isfinite(v) ? v : (++repaired, 0.f);
+        }
+      }
+    }
+  if (nonfinite_values) *nonfinite_values = repaired;
+  return lf;
+}
+
+DeepSamples encode_lightfield(const LightField& lf) {
+  DeepSamples d;
+  d.width = lf.width;
+  d.height = lf.height;
+  const std::size_t spp = std::size_t(lf.spp()), np = lf.pixels();
+  if (lf.r.size() != lf.samples() || lf.smin.size() != np)
+    throw Error(Errc::Internal, "encode_lightfield: arrays do not match width x height x l*l");
+  d.offsets.resize(np + 1);
+  for (std::size_t p = 0; p <= np; ++p) d.offsets[p] = std::uint64_t(p) * spp;
+  for (const char* c : kSampleChannels) d.channel_names.push_back(c);
+  for (const char* c : kPixelChannels) d.channel_names.push_back(c);
+  if (lf.has_geometry())
+    for (const char* c : kGeometryChannels) d.channel_names.push_back(c);
+  d.values.reserve(d.channel_names.size());
+  for (const auto* v : {&lf.r, &lf.g, &lf.b, &lf.y1, &lf.y2}) d.values.push_back(*v);
+  auto repeat = [&](const std::vector<float>& per_pixel) {
+    std::vector<float> out(np * spp);
+    for (std::size_t p = 0; p < np; ++p)
+      for (std::size_t k = 0; k < spp; ++k) out[p * spp + k] = per_pixel[p];
+    d.values.push_back(std::move(out));
+  };
+  for (const auto* v : {&lf.smin, &lf.smax, &lf.e1x, &lf.e1y, &lf.e2x, &lf.e2y, &lf.depth}) repeat(*v);
+  if (lf.has_geometry())
+    for (const auto* v : {&lf.px, &lf.py, &lf.pz, &lf.nx, &lf.ny, &lf.nz}) repeat(*v);
+  d.attributes["mcrecon:lightfield"] = effect_name(lf.effect);
+  d.attributes["mcrecon:lf_l"] = std::to_string(lf.l);
+  std::ostringstream yr, sy;
+  yr.precision(9);
+  sy.precision(9);
+  yr << lf.y_range;
+  sy << lf.sigma_y;
+  d.attributes["mcrecon:lf_y_range"] = yr.str();
+  d.attributes["mcrecon:lf_sigma_y"] = sy.str();
+  return d;
+}
+
+}  // namespace mcr
