@@ -19,7 +19,7 @@ Run add_filters(CLI::App& app) {
     }
     for (const auto& name : catalog_names()) {
       const FilterInfo& f = catalog_info(name);
-      std::cout << f.name << ": " << f.summary << (f.temporal ? " [temporal]" : "") << (f.deep_input ? " [per-sample: deep EXR input]" : "") << "\n";
+      std::cout << f.name << ": " << f.summary << (f.temporal ? " [temporal]" : "") << (f.lightfield_input ? " [light field: deep EXR input]" : f.deep_input ? " [per-sample: deep EXR input]" : "") << "\n";
       // Under the default settings (other settings may need more: `info` and errors say which).
       auto filter = make_catalog_filter(name);
       filter->commit();

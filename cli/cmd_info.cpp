@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "commands.h"
+#include "image/lightfield.h"
 #include "io/frame_reader.h"
 #include "json_views.h"
 #include "pipeline/components.h"
@@ -39,6 +40,18 @@ nlohmann::json deep_report(const DeepSamples& d) {
           {"camera", camera}};
 }
 
+// A light field (README: the light-field convention): effect, sampling, slopes, work to do.
+nlohmann::json lightfield_report(const DeepSamples& d, const std::string& path) {
+  std::size_t repaired = 0;
+  const LightField lf = decode_lightfield(d, path, &repaired);
+  const LightFieldSummary s = summarize(lf);
+  return {{"effect", effect_name(lf.effect)}, {"l", lf.l}, {"spp", lf.spp()}, {"y_range", lf.y_range},
+          {"sigma_y", lf.sigma_y}, {"slope_min", s.slope_min}, {"slope_max", s.slope_max},
+          {"pixels", lf.pixels()}, {"nothing_to_shear", s.nothing_to_shear}, {"opposite_slope_signs", s.opposite_signs},
+          {"converged", s.converged}, {"axis1_pixels_per_unit", s.e1_mean}, {"axis2_pixels_per_unit", s.e2_mean},
+          {"geometry", lf.has_geometry()}, {"nonfinite_values_replaced", repaired}};
+}
+
 struct InfoArgs {
   std::string input, layer;
   std::vector<std::string> passes;
@@ -71,7 +84,10 @@ int run_info(const InfoArgs& a) {
     const auto f = make_committed_filter(name, {});
     nlohmann::json missing = nlohmann::json::array(), uses = nlohmann::json::array();
     for (Role r : f->missing_passes(frame)) missing.push_back(role_name(r));
-    if (f->info().deep_input && !frame.deep) missing.push_back("per-sample (deep) input");
+    if (f->info().lightfield_input && !(frame.deep && is_lightfield(*frame.deep)))
+      missing.push_back("light-field (deep EXR) input");
+    else if (f->info().deep_input && !frame.deep)
+      missing.push_back("per-sample (deep) input");
     for (Role r : f->needs().optional)
       if (frame.has(r)) uses.push_back(role_name(r));
     filters.push_back({{"name", name}, {"can_run", missing.empty()}, {"missing", missing}, {"uses", uses}});
@@ -83,6 +99,7 @@ int run_info(const InfoArgs& a) {
   if (frame.deep) {
     j["deep_samples"] = frame.deep->total_samples();
     j["deep_buffer"] = deep_report(*frame.deep);
+    if (is_lightfield(*frame.deep)) j["lightfield"] = lightfield_report(*frame.deep, frame.path);
   }
   if (a.json) {
     std::cout << j.dump(2) << "\n";
@@ -106,6 +123,18 @@ int run_info(const InfoArgs& a) {
     if (d["camera"].empty()) std::cout << " (no mcrecon:* attributes)";
     for (const auto& [k, v] : d["camera"].items()) std::cout << " " << k << "=" << v.get<std::string>();
     std::cout << "\n";
+  }
+  if (j.contains("lightfield")) {
+    const auto& l = j["lightfield"];
+    std::cout << "light field: " << l["effect"].get<std::string>() << ", " << l["l"].get<int>() << "x"
+              << l["l"].get<int>() << " samples per pixel over y in [-" << l["y_range"].get<float>() << ", "
+              << l["y_range"].get<float>() << "]^2, sigma_y " << l["sigma_y"].get<float>() << "\n  slopes "
+              << l["slope_min"].get<float>() << " .. " << l["slope_max"].get<float>() << "; nothing to shear in "
+              << l["nothing_to_shear"].get<std::size_t>() << " of " << l["pixels"].get<std::size_t>()
+              << " pixels, slopes of both signs (axis-aligned fallback) in " << l["opposite_slope_signs"].get<std::size_t>()
+              << ", converged " << l["converged"].get<std::size_t>() << "\n  axes: " << l["axis1_pixels_per_unit"].get<float>()
+              << " and " << l["axis2_pixels_per_unit"].get<float>() << " pixels per x unit (mean); geometry (P, N): "
+              << (l["geometry"].get<bool>() ? "yes" : "no") << "\n";
   }
   std::cout << "layers:";
   for (const auto& l : frame.layers) std::cout << " " << (l.empty() ? "(top level)" : l);

@@ -26,6 +26,7 @@ struct FilterInfo {
   PrepSteps steps;             // the preparation steps it takes (their parameters end its table)
   bool temporal = false;       // keeps history between execute() calls (frame order matters)
   bool deep_input = false;     // reads the frame's per-sample (deep) buffer; a flat frame is refused
+  bool lightfield_input = false;  // reads a light-field deep EXR (image/lightfield.h); with deep_input
   std::string nonfinite_policy;  // what it does with NaN/Inf input, for docs and `filters`
 };
 

@@ -1,5 +1,6 @@
 #include "image/lightfield.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <sstream>
@@ -28,6 +29,11 @@ void LightField::resize(int w, int h, int l_, bool geometry) {
 }
 
 bool is_lightfield(const DeepSamples& deep) { return deep.attributes.count("mcrecon:lightfield") != 0; }
+
+float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range, float y) {
+  if (effect == LightFieldEffect::Gi) return std::fabs(y) <= y_range ? 1.f : 0.f;
+  return std::exp(-0.5f * (y / sigma_y) * (y / sigma_y));
+}
 
 namespace {
 
@@ -178,6 +184,34 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
     }
   if (nonfinite_values) *nonfinite_values = repaired;
   return lf;
+}
+
+LightFieldSummary summarize(const LightField& lf) {
+  LightFieldSummary s;
+  bool first = true;
+  double e1 = 0, e2 = 0;
+  const std::size_t spp = std::size_t(lf.spp());
+  for (std::size_t p = 0; p < lf.pixels(); ++p) {
+    const float a = lf.smin[p], b = lf.smax[p];
+    if (a == 0 && b == 0) {
+      ++s.nothing_to_shear;
+    } else {
+      s.slope_min = first ? a : std::min(s.slope_min, a);
+      s.slope_max = first ? b : std::max(s.slope_max, b);
+      first = false;
+      s.opposite_signs += a * b < 0;
+    }
+    bool same = true;
+    for (std::size_t k = 1; k < spp && same; ++k) {
+      const std::size_t i = p * spp;
+      same = lf.r[i + k] == lf.r[i] && lf.g[i + k] == lf.g[i] && lf.b[i + k] == lf.b[i];
+    }
+    s.converged += same;
+    e1 += std::hypot(lf.e1x[p], lf.e1y[p]);
+    e2 += std::hypot(lf.e2x[p], lf.e2y[p]);
+  }
+  if (lf.pixels()) s.e1_mean = float(e1 / double(lf.pixels())), s.e2_mean = float(e2 / double(lf.pixels()));
+  return s;
 }
 
 DeepSamples encode_lightfield(const LightField& lf) {

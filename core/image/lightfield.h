@@ -65,10 +65,24 @@ struct LightField {
 // header attributes mcrecon:lightfield (effect), mcrecon:lf_l, mcrecon:lf_y_range,
 // mcrecon:lf_sigma_y.
 bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield
+// The weight over one axis of y: the Gaussian light or aperture, exp(-y^2 / (2 sigma_y^2)), or
+// for gi the v-plane truncation (1 inside [-L, L], else 0). A pixel's unfiltered estimate is
+// the mean of its samples weighted by w(y1) w(y2).
+float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range, float y);
 // Throws Error (BadInput / MissingPass) naming `path` and what is wrong: a missing channel or
 // attribute, a pixel without exactly l*l samples, a non-finite or out-of-range coordinate, a
 // non-finite slope or axis, l outside 1..64. Non-finite values become 0 (and are counted).
 LightField decode_lightfield(const DeepSamples& deep, const std::string& path, std::size_t* nonfinite_values = nullptr);
 DeepSamples encode_lightfield(const LightField& lf);
+
+// What `mcrecon info` says of a light field: its slopes and how many pixels need shearing.
+struct LightFieldSummary {
+  float slope_min = 0, slope_max = 0;  // over the pixels with bounds
+  std::size_t nothing_to_shear = 0;     // smin = smax = 0 (unoccluded, in focus)
+  std::size_t opposite_signs = 0;       // smin * smax < 0 (depth of field across the focus plane)
+  std::size_t converged = 0;            // every sample of the pixel the same value
+  float e1_mean = 0, e2_mean = 0;       // mean screen length of one x unit along x1, x2 (pixels)
+};
+LightFieldSummary summarize(const LightField& lf);
 
 }  // namespace mcr

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <set>
 
+#include "image/lightfield.h"
 #include "io/half_buffers.h"
 #include "io/channel_roles.h"
 #include "io/input_limits.h"
@@ -102,19 +103,31 @@ void read_deep(ImageInput& in, RawImage& raw, const std::string& path) {
   raw.deep = copy_deep(*deepbuf.deepdata(), deepbuf.spec());
   if (deepbuf.spec().alpha_channel < 0) {
     // No alpha: independent samples (the per-sample convention, README): the flat passes are
-    // the mean of each pixel's samples (Alg. 1 of Shirley et al., the 1-pixel box).
+    // the mean of each pixel's samples (Alg. 1 of Shirley et al., the 1-pixel box). A light
+    // field's samples are weighted by its light or aperture (its unfiltered estimate), after
+    // the file has been checked against the light-field convention.
     const DeepSamples& d = *raw.deep;
     const std::size_t nc = d.channel_names.size(), np = std::size_t(raw.width) * std::size_t(raw.height);
+    std::vector<float> weight;
+    if (is_lightfield(d)) {
+      const LightField lf = decode_lightfield(d, path);
+      weight.resize(lf.samples());
+      for (std::size_t i = 0; i < weight.size(); ++i)
+        weight[i] = lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[i]) *
+                    lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[i]);
+    }
     raw.names = d.channel_names;
     raw.pixels.assign(np * nc, 0.0f);
     for (std::size_t p = 0; p < np; ++p) {
       const std::uint64_t a = d.offsets[p], b = d.offsets[p + 1];
       for (std::size_t c = 0; c < nc; ++c) {
-        double sum = 0;
-        std::uint64_t n = 0;
+        double sum = 0, n = 0;
         for (std::uint64_t i = a; i < b; ++i)
-          if (std::isfinite(d.values[c][i])) sum += d.values[c][i], ++n;
-        raw.pixels[p * nc + c] = n ? float(sum / double(n)) : 0.0f;
+          if (std::isfinite(d.values[c][i])) {
+            const double w = weight.empty() ? 1.0 : double(weight[i]);
+            sum += w * d.values[c][i], n += w;
+          }
+        raw.pixels[p * nc + c] = n > 0 ? float(sum / n) : 0.0f;
       }
     }
     return;

@@ -111,8 +111,8 @@ TEST_F(LightFieldFileTest, MissingSlopeChannelsAreNamed) {
   d.values.erase(d.values.begin() + c);
   const std::string f = path("noslope.exr");
   write_deep_samples(d, f);
-  const Frame frame = read_frame(f);
-  expect_error(Errc::MissingPass, {f, "lf.smax", "slope bounds"}, [&] { decode_lightfield(*frame.deep, f); });
+  // Refused when read (the flat colour needs the coordinates), before any filter sees it.
+  expect_error(Errc::MissingPass, {f, "lf.smax", "slope bounds"}, [&] { read_frame(f); });
 }
 
 TEST_F(LightFieldFileTest, NanCoordinatesAreRefusedWithThePixel) {
@@ -159,6 +159,36 @@ TEST_F(LightFieldFileTest, BoundsAndAttributesAreChecked) {
   d = encode_lightfield(small_field(false));
   for (int k = 0; k < 4; ++k) d.values[d.channel("lf.e1x")][4 + k] = std::numeric_limits<float>::infinity();
   expect_error(Errc::ReadFailed, {"pixel (1, 0)", "lf.e1x"}, [&] { round_trip(d); });
+}
+
+}  // namespace
+}  // namespace mcr
+
+namespace mcr {
+namespace {
+
+// The flat colour of a light field is its unfiltered estimate: the samples weighted by the
+// Gaussian light/aperture (a plain mean for gi, whose samples carry their weights).
+TEST_F(LightFieldFileTest, TheFlatColourIsTheWeightedSampleMean) {
+  for (LightFieldEffect e : {LightFieldEffect::Dof, LightFieldEffect::Gi}) {
+    LightField a = small_field(false);
+    a.effect = e;
+    const std::string f = path("flat.exr");
+    write_deep_samples(encode_lightfield(a), f);
+    const Frame frame = read_frame(f);
+    const Image& c = frame.image(Role::Colour);
+    for (int p = 0; p < 6; ++p) {
+      double sum = 0, wsum = 0;
+      for (int k = 0; k < 4; ++k) {
+        const int s = p * 4 + k;
+        const double w = e == LightFieldEffect::Gi ? 1.0
+                                                   : std::exp(-0.5 * (a.y1[s] / 0.5) * (a.y1[s] / 0.5)) *
+                                                         std::exp(-0.5 * (a.y2[s] / 0.5) * (a.y2[s] / 0.5));
+        sum += w * a.g[s], wsum += w;
+      }
+      EXPECT_NEAR(c.at(p % 3, p / 3, 1), sum / wsum, 1e-5) << effect_name(e) << " pixel " << p;
+    }
+  }
 }
 
 }  // namespace
