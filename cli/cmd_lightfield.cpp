@@ -69,13 +69,16 @@ Run add_lightfield(CLI::App& app) {
   std::string names;
   for (const auto& n : lfgen::scene_names()) names += (names.empty() ? "" : "|") + n;
   app.add_option("--scene", a->scene, names)->required();
-  app.add_option("--spp", a->spp, "samples per pixel, l*l on an l x l grid of strata (default 16)")
-      ->check(perfect_square(16));
+  CLI::Option* spp = app.add_option("--spp", a->spp, "samples per pixel, l*l on an l x l grid of strata (default 16)")
+                         ->check(perfect_square(16));
   app.add_option("-o,--output", a->output, "output .exr: deep light-field samples, or with --reference the flat image")
       ->required();
-  app.add_flag("--reference", a->reference, "write the converged image (flat RGB) instead of the samples");
+  // A setting that would do nothing is refused (CLI11 names both options).
+  CLI::Option* reference =
+      app.add_flag("--reference", a->reference, "write the converged image (flat RGB) instead of the samples")->excludes(spp);
   app.add_option("--reference-spp", a->reference_spp, "samples per pixel of --reference (default 1024 = 32x32)")
-      ->check(perfect_square(64));
+      ->check(perfect_square(64))
+      ->needs(reference);
   app.add_option("--width", a->width, "image width (default 128)")->check(whole_number(1, 8192));
   app.add_option("--height", a->height, "image height (default 128)")->check(whole_number(1, 8192));
   app.add_option("--seed", a->seed, "seed of the per-pixel jitter (same seed, same file)");

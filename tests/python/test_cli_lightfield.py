@@ -1,7 +1,7 @@
 """`mcrecon lightfield` end to end: the deep light-field file (channels, l*l samples per pixel,
 header attributes), the flat reference, one seed one file, and the errors: a --spp that is
 not a perfect square l*l with l in 1..16, an unknown scene, a non-.exr output (exit 2, the
-typed value named, nothing written).
+typed value named, nothing written), and settings that would do nothing.
 """
 import os
 import shutil
@@ -113,6 +113,14 @@ class LightFieldCli(unittest.TestCase):
         p = tu.run_cli("lightfield", "--scene", "dof", "-o", os.path.join(self.dir, "x.png"), check=False)
         self.assertEqual(p.returncode, 2, p.stderr)
         self.assertIn("x.png", p.stderr)
+        # Settings that would do nothing: --spp with --reference, --reference-spp without it.
+        p = tu.run_cli("lightfield", "--scene", "dof", "--reference", "--spp", 16, "-o", out, check=False)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("--spp", p.stderr)
+        self.assertIn("--reference", p.stderr)
+        p = tu.run_cli("lightfield", "--scene", "dof", "--reference-spp", 16, "-o", out, check=False)
+        self.assertEqual(p.returncode, 2, p.stderr)
+        self.assertIn("--reference-spp", p.stderr)
         self.assertEqual([f for f in os.listdir(self.dir) if "mcrecon-tmp" in f or f in ("err.exr", "x.png")], [])
 
 
