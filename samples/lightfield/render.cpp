@@ -60,10 +60,14 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
                              const RowProgress& progress) {
   check_samples_per_axis(l);
   LightField lf;
+  lf.resize(gen.width(), gen.height(), l, true);
+  // Set after resize whatever it does with them (it is main's, core/image/lightfield.cpp).
+  lf.width = gen.width();
+  lf.height = gen.height();
+  lf.l = l;
   lf.effect = gen.effect();
   lf.y_range = float(gen.y_range());
   lf.sigma_y = float(gen.sigma_y());
-  lf.resize(gen.width(), gen.height(), l, true);
   const std::size_t spp = std::size_t(l) * std::size_t(l);
   std::atomic<int> rows{0};
   std::mutex report;
