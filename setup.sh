@@ -16,6 +16,7 @@ PACKAGES=(
   libopenimageio-dev openimageio-tools python3-openimageio
   libopenexr-dev libopencolorio-dev
   libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
+  libembree-dev  # Embree 3: the light-field sample generators (samples/lightfield)
   libgtest-dev libbenchmark-dev
   pybind11-dev python3-pybind11 python3-numpy
   blender xvfb xauth

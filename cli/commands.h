@@ -26,5 +26,6 @@ Run add_compare(CLI::App& app);
 Run add_demo(CLI::App& app);
 Run add_sparsify(CLI::App& app);
 Run add_plan(CLI::App& app);
+Run add_lightfield(CLI::App& app);
 
 }  // namespace mcr::cli

@@ -57,6 +57,8 @@ int main(int argc, char** argv) {
       mcr::cli::add_plan);
   add("sparsify", "subsample a render with the thesis' foveated expanded grid (holes for pull-push)",
       mcr::cli::add_sparsify);
+  add("lightfield", "render light-field samples (soft shadows, depth of field, indirect light) for the sheared filters",
+      mcr::cli::add_lightfield);
   add("demo", "run every filter on the sample scenes: table + side-by-side PNGs", mcr::cli::add_demo);
 
   try {

@@ -41,4 +41,24 @@ inline CLI::Validator number_in(double lo, double hi) {
       "NUMBER in " + range);
 }
 
+// A sample count l*l with l in 1..max_l (light-field samples sit on an l x l grid of strata).
+inline CLI::Validator perfect_square(int max_l) {
+  std::string squares;
+  for (int l = 1; l <= max_l; ++l)
+    if (l <= 4 || l == max_l) squares += (squares.empty() ? "" : l == max_l ? ", ..., " : ", ") + std::to_string(l * l);
+  const std::string what = "expects a perfect square l*l with l in 1.." + std::to_string(max_l) + " (" + squares + ")";
+  return CLI::Validator(
+      [max_l, what](std::string& text) -> std::string {
+        errno = 0;
+        char* end = nullptr;
+        const long long v = std::strtoll(text.c_str(), &end, 10);
+        long long l = 0;
+        while ((l + 1) * (l + 1) <= v && l < max_l) ++l;
+        if (text.empty() || *end != '\0' || errno == ERANGE || v < 1 || l * l != v)
+          return what + ", got '" + text + "'";
+        return "";
+      },
+      "l*l, l in 1.." + std::to_string(max_l));
+}
+
 }  // namespace mcr::cli

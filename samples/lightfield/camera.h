@@ -1,0 +1,26 @@
+#pragma once
+// A pinhole camera through the lens centre; the thin lens of the dof scene adds an aperture
+// on top of it (dof.cpp). Image coordinates are pixels, (0,0) the top-left corner, a pixel's
+// centre at +0.5; `right` and `down` point along image +x and +y.
+#include "vec3.h"
+
+namespace mcr::lfgen {
+
+struct Camera {
+  int width = 0, height = 0;
+  Vec3 eye, forward, right, down;  // orthonormal
+  double focal_px = 1;             // lens centre to image plane, in pixels
+
+  // Looking from eye at target, `up` roughly up, vertical field of view in degrees.
+  static Camera look_at(int width, int height, const Vec3& eye, const Vec3& target, const Vec3& up,
+                        double vfov_deg);
+  // Unit direction from the lens centre through image point (px, py).
+  Vec3 direction(double px, double py) const;
+  // Image point of world point p through the lens centre; false behind the camera.
+  bool project(const Vec3& p, double& px, double& py) const;
+  // Pixels moved on screen per world unit that p moves along d: project p and p + eps d,
+  // divide by eps (a finite difference of the projection, eps relative to p's depth).
+  void screen_axis(const Vec3& p, const Vec3& d, double& ex, double& ey) const;
+};
+
+}  // namespace mcr::lfgen
