@@ -11,7 +11,7 @@
 //   soft shadows:  s = d1/d2 - 1   (d1: light to receiver, d2: light to occluder), y on the
 //                  light in world units, Gaussian light of standard deviation sigma_y;
 //   depth of field: s = -c, c the circle of confusion radius in pixels per unit of lens
-//                  coordinate (signed: negative behind the focus plane), y on the lens,
+//                  coordinate (signed: positive behind the focus plane), y on the lens,
 //                  Gaussian aperture of standard deviation sigma_y;
 //   indirect light: s = z, the reflector's distance from the receiver along the normal, y on
 //                  the v-plane at unit distance (tangent of the direction), values already
