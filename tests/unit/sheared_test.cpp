@@ -142,5 +142,57 @@ TEST(Sheared, MatchesSheared4dOnAStepWithSkewedAxes) {
   EXPECT_LE(e, 0.01);
 }
 
+// The closed form of sheared4d_test's field of one slope, through the factored steps. Here
+// sigma_y = L / 5 (the closed form needs the y range to cover the sheared Gaussian), so 16 bins
+// over [-1.4, 1.4] lie 0.875 sigma_y apart (the paper's L = 2 sigma_y: 0.5 sigma_y) and their
+// linear reading costs accuracy: 16 bins land well below the pixels' own means, 64 bins near the
+// 4D filter's error (0.001), 4 bins lose the signal.
+TEST(Sheared, OneSlopeFieldMatchesItsClosedForm) {
+  const double A = 0.5, B = 0.3, C = 0.2, k1 = 7, k2 = 5;
+  const float s = 40;
+  LightField lf = make_lightfield(LightFieldEffect::Dof, 40, 40, 6, 1.0f, 0.2f, false);
+  testutil::jitter_samples(lf, 61);
+  testutil::set_slopes(lf, s, s);
+  testutil::fill_values(lf, [&](double X1, double X2, double y1, double y2) {
+    return A + B * std::sin(k1 * (y1 + X1 / s)) + C * std::cos(k2 * (y2 + X2 / s));
+  });
+  Image exact(40, 40, 3);
+  for (std::size_t p = 0; p < lf.pixels(); ++p) {
+    double X1, X2;
+    testutil::x_units(lf, p, &X1, &X2);
+    const double v = A + B * std::exp(-k1 * k1 * 0.02) * std::sin(k1 * X1 / s) +
+                     C * std::exp(-k2 * k2 * 0.02) * std::cos(k2 * X2 / s);  // sigma_y^2 / 2 = 0.02
+    for (int c = 0; c < 3; ++c) exact.data()[p * 3 + std::size_t(c)] = float(v * (1.0 - 0.2 * c));
+  }
+  const double own = testutil::rms_diff(exact, testutil::plain_mean(lf));
+  const double err = testutil::rms_diff(exact, run_fast(lf, opts(16)));  // 16 bins
+  auto with_bins = [&](int bins) {
+    lf::Options o = opts(16);
+    o.bins = bins;
+    return testutil::rms_diff(exact, run_fast(lf, o));
+  };
+  const double err4 = with_bins(4), err64 = with_bins(64);
+  std::printf("closed form: own means %.5f, sheared 16 bins %.5f, 4 bins %.5f, 64 bins %.5f\n", own, err, err4, err64);
+  EXPECT_LT(err, own / 5);
+  EXPECT_LT(err64, 0.004);
+  EXPECT_GT(err4, 2 * err);
+  EXPECT_GT(err, 2 * err64);
+}
+
+TEST(Sheared, SameBitsOnAnyThreadCountWithManyY2Values) {
+  // Independent random y per sample (no shared jitter): l*l distinct y2 values per pixel.
+  LightField lf = make_lightfield(LightFieldEffect::Dof, 33, 21, 3, 1.0f, 0.5f, false);
+  std::mt19937 rng(71);
+  std::uniform_real_distribution<float> u(-1.0f, 1.0f);
+  for (std::size_t k = 0; k < lf.samples(); ++k) {
+    lf.y1[k] = u(rng);
+    lf.y2[k] = u(rng);
+  }
+  smooth_random_slopes(lf, 1.0f, 6.0f, 72);
+  fill_mixed(lf);
+  EXPECT_TRUE(testutil::same_bits(run_fast(lf, opts(16), 1), run_fast(lf, opts(16), 2)));
+  EXPECT_LE(rel(lf, opts(16)), 0.01);
+}
+
 }  // namespace
 }  // namespace mcr
