@@ -179,6 +179,44 @@ TEST(Sheared, OneSlopeFieldMatchesItsClosedForm) {
   EXPECT_GT(err, 2 * err64);
 }
 
+TEST(Sheared, MatchesSheared4dNextToPixelsWithNothingToShear) {
+  // Depth of field: the left half in focus (bounds 0: own samples), the right half blurred, a
+  // band of opposite-sign bounds (the axis-aligned fallback) between them.
+  LightField lf = make_lightfield(LightFieldEffect::Dof, 40, 36, 3, 1.0f, 0.5f, false);
+  testutil::jitter_samples(lf, 81);
+  for (int y = 0; y < lf.height; ++y)
+    for (int x = 0; x < lf.width; ++x) {
+      const std::size_t p = std::size_t(y) * std::size_t(lf.width) + std::size_t(x);
+      lf.smin[p] = x < 16 ? 0.0f : x < 20 ? -1.0f : 2.0f;
+      lf.smax[p] = x < 16 ? 0.0f : x < 20 ? 3.0f : 3.5f;
+    }
+  fill_mixed(lf);
+  const double e = rel(lf, opts(16));
+  std::printf("in focus | fallback | blurred: relMSE %.5f\n", e);
+  EXPECT_LE(e, 0.01);
+}
+
+TEST(Sheared, MatchesSheared4dWithRejectionAtAnEdge) {
+  // Soft shadows on two planes meeting at x = 20: a 60 degree fold and a depth step; rejection
+  // in both filters (the fast one between P and each Q_j of its two lines, so the sets differ).
+  LightField lf = make_lightfield(LightFieldEffect::SoftShadows, 40, 36, 3, 1.0f, 0.5f, true);
+  testutil::jitter_samples(lf, 91);
+  testutil::set_axes(lf, 2, 0, 0, 2);
+  smooth_random_slopes(lf, 1.0f, 6.0f, 92);
+  for (int y = 0; y < lf.height; ++y)
+    for (int x = 0; x < lf.width; ++x) {
+      const std::size_t p = std::size_t(y) * std::size_t(lf.width) + std::size_t(x);
+      lf.px[p] = (float(x) + 0.5f) / 2;
+      lf.py[p] = (float(y) + 0.5f) / 2;
+      lf.pz[p] = x < 20 ? 0.0f : 3.0f;
+      if (y > 18) lf.nx[p] = std::sin(1.047f), lf.nz[p] = std::cos(1.047f);
+    }
+  fill_mixed(lf);
+  const double e = rel(lf, opts(16));
+  std::printf("rejection at an edge: relMSE %.5f\n", e);
+  EXPECT_LE(e, 0.01);
+}
+
 TEST(Sheared, SameBitsOnAnyThreadCountWithManyY2Values) {
   // Independent random y per sample (no shared jitter): l*l distinct y2 values per pixel.
   LightField lf = make_lightfield(LightFieldEffect::Dof, 33, 21, 3, 1.0f, 0.5f, false);
