@@ -126,8 +126,15 @@ void sheared_lightfield(const LightField& lf, const lf::Options& o, const Roi& r
   for (std::size_t p = 0; p < n; ++p) gofs[p + 1] = gofs[p] + groups[p];
   std::vector<float> gy2(gofs[n]);
   std::vector<float> pre(gofs[n] * B4, 0.0f);  // [group][bin][r, g, b, weight]
+  // Gaussian w_y at the bin centres by a recurrence over the bins (two exp per sample, not B):
+  // w_{b+1} = w_b exp(2 u delta k) exp(-(2b+1) delta^2 k), u = y1 - centre(0), k = 1/(2 sigma_y^2),
+  // in double while every factor stays far inside its range (else exp per bin).
+  const double k2 = wy.inv2sy2, dlt = bins.delta;
+  std::vector<double> step(std::size_t(B), 1.0);
+  for (int bi = 0; bi + 1 < B; ++bi) step[std::size_t(bi)] = std::exp(-double(2 * bi + 1) * dlt * dlt * k2);
   parallel_rows(r1.y0, r1.y1, nthreads, [&](int y) {
     std::vector<std::size_t> idx(spp);
+    std::vector<double> acc(B4), wb(static_cast<std::size_t>(B));
     for (int x = r1.x0; x < r1.x1; ++x) {
       const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
       std::iota(idx.begin(), idx.end(), p * spp);
@@ -137,23 +144,32 @@ void sheared_lightfield(const LightField& lf, const lf::Options& o, const Roi& r
         std::size_t e = i;
         while (e < spp && lf.y2[idx[e]] == lf.y2[idx[i]]) ++e;
         gy2[g] = lf.y2[idx[i]];
-        float* dst = pre.data() + g * B4;
-        for (int bi = 0; bi < B; ++bi) {
-          const float cb = bins.centre(bi);
-          double s0 = 0, s1 = 0, s2 = 0, sw = 0;
-          for (std::size_t m = i; m < e; ++m) {
-            const std::size_t k = idx[m];
-            const double wk = wy(lf.y1[k] - cb);
-            s0 += wk * lf.r[k];
-            s1 += wk * lf.g[k];
-            s2 += wk * lf.b[k];
-            sw += wk;
+        std::fill(acc.begin(), acc.end(), 0.0);
+        for (std::size_t m = i; m < e; ++m) {
+          const std::size_t k = idx[m];
+          const double u = double(lf.y1[k]) - double(bins.centre(0));
+          if (!wy.box && u * u * k2 < 600 && 2 * std::fabs(u) * dlt * k2 < 600) {
+            double wk = std::exp(-u * u * k2);
+            const double a = std::exp(2 * u * dlt * k2);
+            for (int bi = 0; bi < B; ++bi) {
+              wb[std::size_t(bi)] = wk;
+              wk *= a * step[std::size_t(bi)];
+            }
+          } else {
+            for (int bi = 0; bi < B; ++bi) wb[std::size_t(bi)] = wy(lf.y1[k] - bins.centre(bi));
           }
-          dst[bi * 4 + 0] = float(s0);
-          dst[bi * 4 + 1] = float(s1);
-          dst[bi * 4 + 2] = float(s2);
-          dst[bi * 4 + 3] = float(sw);
+          const double f0 = lf.r[k], f1 = lf.g[k], f2 = lf.b[k];
+          for (int bi = 0; bi < B; ++bi) {
+            const double wk = wb[std::size_t(bi)];
+            double* d = acc.data() + std::size_t(bi) * 4;
+            d[0] += wk * f0;
+            d[1] += wk * f1;
+            d[2] += wk * f2;
+            d[3] += wk;
+          }
         }
+        float* dst = pre.data() + g * B4;
+        for (std::size_t j = 0; j < B4; ++j) dst[j] = float(acc[j]);
         ++g;
         i = e;
       }
