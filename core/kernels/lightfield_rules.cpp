@@ -76,6 +76,16 @@ std::vector<Rule> pixel_rules(const LightField& lf, const Options& o, Mode mode,
     throw Error(Errc::InvalidArgument, "light field: sigma_y must be a positive number, not " + std::to_string(lf.sigma_y));
   if (!(lf.y_range > 0) || !std::isfinite(lf.y_range))
     throw Error(Errc::InvalidArgument, "light field: y_range must be a positive number, not " + std::to_string(lf.y_range));
+  const std::size_t ns = lf.samples(), np = lf.pixels();
+  bool sized = lf.l >= 1 && lf.width >= 0 && lf.height >= 0;
+  for (const std::vector<float>* v : {&lf.r, &lf.g, &lf.b, &lf.y1, &lf.y2}) sized = sized && v->size() == ns;
+  for (const std::vector<float>* v : {&lf.smin, &lf.smax, &lf.e1x, &lf.e1y, &lf.e2x, &lf.e2y})
+    sized = sized && v->size() == np;
+  if (lf.has_geometry())
+    for (const std::vector<float>* v : {&lf.px, &lf.py, &lf.pz, &lf.nx, &lf.ny, &lf.nz}) sized = sized && v->size() == np;
+  if (!sized) throw Error(Errc::Internal, "light field: arrays not sized for " + std::to_string(lf.width) + "x" +
+                                              std::to_string(lf.height) + " pixels of " + std::to_string(lf.l) +
+                                              "x" + std::to_string(lf.l) + " samples");
   std::vector<float> lo, hi;
   std::vector<unsigned char> took;
   smoothed_bounds(lf, o.smooth_radius, lo, hi, took);

@@ -62,7 +62,8 @@ enum class Mode { Sheared, AxisAligned };
 
 // The rule of every pixel of lf (soft shadows: after slope smoothing). Counts are of the
 // pixels inside `roi` (the pixels the filter writes). Throws Error(InvalidArgument) when
-// sigma_y or y_range is not a positive finite number.
+// sigma_y or y_range is not a positive finite number, Error(Internal) when an array is not
+// sized for width x height x l*l (decode_lightfield sizes them).
 std::vector<Rule> pixel_rules(const LightField& lf, const Options& o, Mode mode, const Roi& roi, Counts* counts);
 
 // w_y: a Gaussian of sigma_y centred at 0 (soft shadows, dof); gi: the box |y| <= y_range.
