@@ -34,6 +34,9 @@ struct Options {
   bool fallback_aaf = true;   // lo * hi <= 0 (not both 0): the axis-aligned rule (else own mean)
   float mu = 1;               // the axis-aligned rule's mu
   int bins = 16;              // sheared (factored): bins over b and y2
+  // sheared (factored): memory for a band of rows' pre-convolved values (steps 1a, 2a); rows
+  // beyond it go to further bands (same result). Not a parameter; tests make it small.
+  std::size_t band_bytes = std::size_t(512) << 20;
 };
 
 // How a pixel is filtered (its rule also serves its neighbours in the factored filter).

@@ -232,5 +232,22 @@ TEST(Sheared, SameBitsOnAnyThreadCountWithManyY2Values) {
   EXPECT_LE(rel(lf, opts(16)), 0.01);
 }
 
+TEST(Sheared, BandsOfRowsGiveTheSameBits) {
+  // One-row bands (band_bytes 1) against one band, skewed axes (lines cross rows), a roi.
+  LightField lf = make_lightfield(LightFieldEffect::SoftShadows, 37, 31, 3, 1.0f, 0.5f, false);
+  testutil::jitter_samples(lf, 101);
+  testutil::set_axes(lf, 0.9f, 0.7f, -0.5f, 1.2f);
+  smooth_random_slopes(lf, 1.0f, 6.0f, 102);
+  fill_mixed(lf);
+  for (const Roi& roi : {Roi::all(37, 31), Roi{3, 5, 30, 22}}) {
+    Image one(37, 31, 3, -1.0f), rows(37, 31, 3, -1.0f);
+    lf::Options o = opts(16);
+    sheared_lightfield(lf, o, roi, 0, one, nullptr);
+    o.band_bytes = 1;
+    sheared_lightfield(lf, o, roi, 0, rows, nullptr);
+    EXPECT_TRUE(testutil::same_bits(one, rows));
+  }
+}
+
 }  // namespace
 }  // namespace mcr

@@ -14,7 +14,9 @@
 // nearest), zero beyond the outer centres (fading to 0 half a bin out). A pixel's steps 1b-2a
 // use its own rule, so a neighbour's q carries the neighbour's shear (the separable
 // approximation, exact where the rule is constant); rejection is between P and Q_j in 1b
-// and in 2b.
+// and in 2b. Memory: per pixel B * 16 bytes per distinct y2 (l of them under uniform jitter)
+// for p and B * 16 for q; the output rows go in bands whose p and q fit in
+// lf::Options::band_bytes (512 MB), the rows shared by two bands computed in both.
 #include "filters/filter.h"
 #include "image/lightfield.h"
 #include "kernels/lightfield_rules.h"
