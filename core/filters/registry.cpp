@@ -7,6 +7,9 @@
 #include "filters/image/guided.h"
 #include "filters/image/gaussian.h"
 #include "filters/image/pwaf.h"
+#include "filters/lightfield/aaf.h"
+#include "filters/lightfield/sheared.h"
+#include "filters/lightfield/sheared4d.h"
 #include "filters/samples/sweep.h"
 #include "util/error.h"
 
@@ -34,6 +37,9 @@ const std::vector<Entry>& entries() {
       entry<PwafFilter>(),
       entry<BmfrFilter>(),
       entry<SweepFilter>(),
+      entry<ShearedFilter>(),
+      entry<Sheared4dFilter>(),
+      entry<AafFilter>(),
   };
   return list;
 }

@@ -1,0 +1,72 @@
+#include "kernels/lightfield_input.h"
+
+#include "util/error.h"
+
+namespace mcr::lf {
+
+ParamSpec max_width_param() {
+  return ParamSpec::Int("max_width", 32, 1, 128,
+                        "widest filter support, pixels (a diameter; the paper clamps to 32): radius per axis "
+                        "min(ceil(2 sigma_x |e_i|), max_width/2)");
+}
+ParamSpec reject_param() {
+  return ParamSpec::Bool("reject", true,
+                         "soft shadows and gi with geometry: leave out neighbours across a normal or depth edge "
+                         "(normal_degrees; |P_Q - P_P| > 2 |d| + one pixel's world size)");
+}
+ParamSpec normal_degrees_param() {
+  return ParamSpec::Float("normal_degrees", 20, 0, 180,
+                          "rejection: a neighbour whose normal differs by more than this many degrees is left out");
+}
+ParamSpec smooth_radius_param() {
+  return ParamSpec::Int("smooth_radius", 2, 0, 16,
+                        "soft shadows: a pixel with both slope bounds 0 takes the widest bounds of the pixels "
+                        "within this many pixels (2 = 5x5 window, the paper's); 0: off");
+}
+ParamSpec fallback_param() {
+  return ParamSpec::Enum("fallback", "aaf", {"aaf", "own"},
+                         "pixels whose bounds have opposite signs (or one is 0): aaf = the axis-aligned rule for "
+                         "that pixel (eta 0, sigma_x = sigma_y min|s| / (2 mu)); own = its own sample mean");
+}
+ParamSpec mu_param(bool fallback_only) {
+  return ParamSpec::Float("mu", 1, 0.05, 20,
+                          std::string("axis-aligned filter width factor (Mehta 2012): sigma_x = sigma_y min|s| / "
+                                      "(2 mu); above 1 blurs less") +
+                              (fallback_only ? " (the fallback pixels only)" : ""));
+}
+ParamSpec bins_param() {
+  return ParamSpec::Int("bins", 16, 2, 128,
+                        "bins over the filter centre b (step 1a) and over y2 (steps 1b, 2a), read with linear "
+                        "interpolation between bin centres; the paper uses 16 (about 4 l)");
+}
+
+Options options_from(const ParamSet& params) {
+  Options o;
+  if (params.has("max_width")) o.max_width = int(params.get_int("max_width"));
+  if (params.has("reject")) o.reject = params.get_bool("reject");
+  if (params.has("normal_degrees")) o.normal_degrees = float(params.get_float("normal_degrees"));
+  if (params.has("smooth_radius")) o.smooth_radius = int(params.get_int("smooth_radius"));
+  if (params.has("fallback")) o.fallback_aaf = params.get_enum("fallback") == "aaf";
+  if (params.has("mu")) o.mu = float(params.get_float("mu"));
+  if (params.has("bins")) o.bins = int(params.get_int("bins"));
+  return o;
+}
+
+LightField lightfield_input(const Frame& frame, const std::string& filter, std::size_t* nonfinite_values) {
+  if (!frame.deep)
+    throw Error(Errc::MissingPass, "filter '" + filter +
+                                       "' needs a light-field deep EXR (README: the light-field convention); '" +
+                                       frame.path + "' is a flat image");
+  if (!is_lightfield(*frame.deep))
+    throw Error(Errc::MissingPass, "filter '" + filter +
+                                       "' needs a light-field deep EXR (README: the light-field convention); '" +
+                                       frame.path + "' is a deep EXR without the mcrecon:lightfield attribute");
+  LightField lf = decode_lightfield(*frame.deep, frame.path, nonfinite_values);
+  if (lf.width != frame.width || lf.height != frame.height)
+    throw Error(Errc::SizeMismatch, "'" + frame.path + "': the light field is " + std::to_string(lf.width) + "x" +
+                                        std::to_string(lf.height) + ", the frame " + std::to_string(frame.width) +
+                                        "x" + std::to_string(frame.height));
+  return lf;
+}
+
+}  // namespace mcr::lf

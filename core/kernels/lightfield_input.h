@@ -1,0 +1,30 @@
+#pragma once
+// The light-field filters' common front: the parameters they share (one spec each, the same
+// name, range and help in every table) and the decoded light field of a frame.
+#include <cstddef>
+#include <string>
+
+#include "image/lightfield.h"
+#include "image/pass.h"
+#include "kernels/lightfield_rules.h"
+#include "util/params.h"
+
+namespace mcr::lf {
+
+ParamSpec max_width_param();
+ParamSpec reject_param();
+ParamSpec normal_degrees_param();
+ParamSpec smooth_radius_param();
+ParamSpec fallback_param();
+ParamSpec mu_param(bool fallback_only);
+ParamSpec bins_param();
+
+// Options from a ParamSet holding any of the parameters above (absent ones keep their defaults).
+Options options_from(const ParamSet& params);
+
+// The frame's light field: throws Error(MissingPass) naming `filter` and the file when the frame
+// has no deep buffer or one without the light-field attribute (README: the light-field
+// convention), Error(SizeMismatch) when it is not the frame's size; decode's errors pass through.
+LightField lightfield_input(const Frame& frame, const std::string& filter, std::size_t* nonfinite_values);
+
+}  // namespace mcr::lf
