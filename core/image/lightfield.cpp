@@ -25,7 +25,7 @@ void LightField::resize(int w, int h, int l_, bool geometry) {
   const std::size_t n = samples(), p = pixels();
   for (auto* v : {&r, &g, &b, &y1, &y2}) v->assign(n, 0.f);
   for (auto* v : {&smin, &smax, &e1x, &e1y, &e2x, &e2y, &depth}) v->assign(p, 0.f);
-  for (auto* v : {&px, &py, &pz, &nx, &ny, &nz}) v->assign(geometry ? p : 0, 0.f);
+  for (auto* v : {&px, &py, &pz, &nx, &ny, &nz, &w1x, &w1y, &w1z, &w2x, &w2y, &w2z}) v->assign(geometry ? p : 0, 0.f);
 }
 
 bool is_lightfield(const DeepSamples& deep) { return deep.attributes.count("mcrecon:lightfield") != 0; }
@@ -40,6 +40,7 @@ namespace {
 const char* const kSampleChannels[] = {"R", "G", "B", "lf.y1", "lf.y2"};
 const char* const kPixelChannels[] = {"lf.smin", "lf.smax", "lf.e1x", "lf.e1y", "lf.e2x", "lf.e2y", "Z"};
 const char* const kGeometryChannels[] = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z"};
+const char* const kAxisChannels[] = {"lf.w1x", "lf.w1y", "lf.w1z", "lf.w2x", "lf.w2y", "lf.w2z"};
 
 std::string at(int x, int y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
 
@@ -109,6 +110,11 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
   for (int i = 0; i < 6; ++i) present += (gc[i] = deep.channel(kGeometryChannels[i])) >= 0;
   if (present != 0 && present != 6)
     throw Error(Errc::MissingPass, "'" + path + "': light field has only some of P.X P.Y P.Z N.X N.Y N.Z (all six or none)");
+  int ac[6], axes = 0;
+  for (int i = 0; i < 6; ++i) axes += (ac[i] = deep.channel(kAxisChannels[i])) >= 0;
+  if (axes != 0 && (axes != 6 || present != 6))
+    throw Error(Errc::MissingPass, "'" + path + "': light field has " + std::to_string(axes) +
+                                       " of the six world axis channels lf.w1x .. lf.w2z (all six, with P and N, or none)");
   const std::uint64_t spp = std::uint64_t(l) * std::uint64_t(l);
   if (deep.total_samples() != spp * std::uint64_t(deep.width) * std::uint64_t(deep.height)) {
     // Name the first pixel that breaks the rule: more use than a total.
@@ -120,6 +126,8 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
                                             std::to_string(spp) + " in every pixel");
   }
   lf.resize(deep.width, deep.height, l, present == 6);
+  if (axes == 0)
+    for (auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) v->clear();
 
   std::size_t repaired = 0;
   const float ylim = lf.y_range * (1 + 1e-4f);
@@ -181,6 +189,16 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
           geo_dst[i][p] = std::isfinite(v) ? v : (++repaired, 0.f);
         }
       }
+      if (axes == 6) {
+        float* axis_dst[6] = {lf.w1x.data(), lf.w1y.data(), lf.w1z.data(), lf.w2x.data(), lf.w2y.data(), lf.w2z.data()};
+        for (int i = 0; i < 6; ++i) {
+          const float v = deep.values[ac[i]][s0];
+          if (!std::isfinite(v))
+            throw Error(Errc::ReadFailed, "'" + path + "': " + at(x, y) + " has a non-finite " + kAxisChannels[i] +
+                                              " (the world axes of the pixel's filter)");
+          axis_dst[i][p] = v;
+        }
+      }
     }
   if (nonfinite_values) *nonfinite_values = repaired;
   return lf;
@@ -227,6 +245,8 @@ DeepSamples encode_lightfield(const LightField& lf) {
   for (const char* c : kPixelChannels) d.channel_names.push_back(c);
   if (lf.has_geometry())
     for (const char* c : kGeometryChannels) d.channel_names.push_back(c);
+  if (lf.has_world_axes())
+    for (const char* c : kAxisChannels) d.channel_names.push_back(c);
   d.values.reserve(d.channel_names.size());
   for (const auto* v : {&lf.r, &lf.g, &lf.b, &lf.y1, &lf.y2}) d.values.push_back(*v);
   auto repeat = [&](const std::vector<float>& per_pixel) {
@@ -238,6 +258,8 @@ DeepSamples encode_lightfield(const LightField& lf) {
   for (const auto* v : {&lf.smin, &lf.smax, &lf.e1x, &lf.e1y, &lf.e2x, &lf.e2y, &lf.depth}) repeat(*v);
   if (lf.has_geometry())
     for (const auto* v : {&lf.px, &lf.py, &lf.pz, &lf.nx, &lf.ny, &lf.nz}) repeat(*v);
+  if (lf.has_world_axes())
+    for (const auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) repeat(*v);
   d.attributes["mcrecon:lightfield"] = effect_name(lf.effect);
   d.attributes["mcrecon:lf_l"] = std::to_string(lf.l);
   std::ostringstream yr, sy;

@@ -51,17 +51,25 @@ struct LightField {
   std::vector<float> depth;               // receiver depth along the view ray (first hit)
   std::vector<float> px, py, pz;          // receiver world position (empty when the file has none)
   std::vector<float> nx, ny, nz;          // receiver world normal, unit (empty when absent)
+  // World dual axes (empty when absent; only with geometry): a world displacement D of the
+  // receiver is D . w1, D . w2 in x units (soft shadows: the light's axes; gi: the receiver's
+  // tangent axes). With them the filters take a neighbour's displacement from the positions,
+  // exact under perspective, instead of the screen linearisation e1, e2 (which is off by 5% at
+  // 5 pixels on an oblique ground, enough to shear a shadow wrongly at 16).
+  std::vector<float> w1x, w1y, w1z, w2x, w2y, w2z;
 
   int spp() const { return l * l; }
   std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
   std::size_t samples() const { return pixels() * std::size_t(spp()); }
   bool has_geometry() const { return !px.empty() && !nx.empty(); }
-  // Allocates every array for width x height x l*l (geometry too when `geometry`).
+  bool has_world_axes() const { return has_geometry() && !w1x.empty(); }
+  // Allocates every array for width x height x l*l (geometry and world axes too when `geometry`).
   void resize(int w, int h, int l_, bool geometry);
 };
 
 // The deep EXR form: per-sample channels R G B lf.y1 lf.y2, and per-pixel values repeated on
-// each sample: lf.smin lf.smax lf.e1x lf.e1y lf.e2x lf.e2y Z, optionally P.X P.Y P.Z N.X N.Y N.Z;
+// each sample: lf.smin lf.smax lf.e1x lf.e1y lf.e2x lf.e2y Z, optionally P.X P.Y P.Z N.X N.Y N.Z
+// and with them lf.w1x lf.w1y lf.w1z lf.w2x lf.w2y lf.w2z;
 // header attributes mcrecon:lightfield (effect), mcrecon:lf_l, mcrecon:lf_y_range,
 // mcrecon:lf_sigma_y.
 bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield

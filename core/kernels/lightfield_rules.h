@@ -69,14 +69,19 @@ enum class Mode { Sheared, AxisAligned };
 // sized for width x height x l*l (decode_lightfield sizes them).
 std::vector<Rule> pixel_rules(const LightField& lf, const Options& o, Mode mode, const Roi& roi, Counts* counts);
 
-// w_y: a Gaussian of sigma_y centred at 0 (soft shadows, dof); gi: the box |y| <= y_range.
+// w_y: a Gaussian of sigma_y centred at 0 (soft shadows, dof); gi: the box |y| <= y_range. The
+// Gaussian is cut at |y| = y_range too: the light (lens) ends there, so a neighbour's sample that
+// maps to a point beyond it stands for no light at all (without the cut, lit pixels next to a
+// shadow gathered occluded samples from outside the light: dark halos, soft_shadows 0.0017
+// against 0.0005 for the input at 16 spp).
 struct WeightY {
   bool box = false;
   float inv2sy2 = 0;
   float range = 1;
   explicit WeightY(const LightField& lf);
   float operator()(float y) const {
-    return box ? (std::fabs(y) <= range ? 1.0f : 0.0f) : std::exp(-y * y * inv2sy2);
+    if (!(std::fabs(y) <= range)) return 0.0f;
+    return box ? 1.0f : std::exp(-y * y * inv2sy2);
   }
 };
 
@@ -102,6 +107,25 @@ class Rejection {
   const LightField* lf_;
   bool active_ = false;
   float cos_max_ = 1;
+};
+
+// A neighbour's displacement in x units along an axis: exact from the receivers' world positions
+// when the light field has world axes (x_i = (P_q - P_p) . w_i(p)), else the screen linearisation
+// the caller passes (from e1, e2 at p).
+class Displacement {
+ public:
+  explicit Displacement(const LightField& lf) : lf_(&lf), world_(lf.has_world_axes()) {}
+  bool world() const { return world_; }
+  float along(std::size_t p, std::size_t q, int axis, float linear) const {
+    if (!world_) return linear;
+    const LightField& l = *lf_;
+    const float dx = l.px[q] - l.px[p], dy = l.py[q] - l.py[p], dz = l.pz[q] - l.pz[p];
+    return axis == 0 ? dx * l.w1x[p] + dy * l.w1y[p] + dz * l.w1z[p] : dx * l.w2x[p] + dy * l.w2y[p] + dz * l.w2z[p];
+  }
+
+ private:
+  const LightField* lf_;
+  bool world_;
 };
 
 // The pixel nearest to (x, y) + j * (ux, uy) (pixel centres; (ux, uy) a unit screen step),

@@ -21,6 +21,7 @@ struct PixelSamples {
   double e1x = 0, e1y = 0, e2x = 0, e2y = 0;
   double depth = 0;             // along the view ray to the receiver
   Vec3 p, n;                    // receiver position and unit normal
+  Vec3 w1, w2;                  // world dual axes: a receiver displacement D is D . w_i in x units
   void reset(int spp);
   // Widens [smin, smax] by one sample's slope (the first one sets both).
   void add_slope(double s);

@@ -52,6 +52,8 @@ void Gi::render_pixel(int x, int y, int l, double j1, double j2, PixelSamples& o
   out.depth = h.t;
   Vec3 t1, t2;
   tangent_frame(h.n, t1, t2);
+  out.w1 = t1;
+  out.w2 = t2;
   cam.screen_axis(h.p, t1, out.e1x, out.e1y);
   cam.screen_axis(h.p, t2, out.e2x, out.e2y);
   const Vec3 org = h.p + h.n * 1e-4;

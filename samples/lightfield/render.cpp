@@ -18,7 +18,7 @@ void PixelSamples::reset(int spp) {
   has_slope = false;
   e1x = e1y = e2x = e2y = 0;
   depth = 0;
-  p = n = Vec3();
+  p = n = w1 = w2 = Vec3();
 }
 
 void PixelSamples::add_slope(double s) {
@@ -99,6 +99,8 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
       lf.nx[p] = float(ps.n.x);
       lf.ny[p] = float(ps.n.y);
       lf.nz[p] = float(ps.n.z);
+      lf.w1x[p] = float(ps.w1.x), lf.w1y[p] = float(ps.w1.y), lf.w1z[p] = float(ps.w1.z);
+      lf.w2x[p] = float(ps.w2.x), lf.w2y[p] = float(ps.w2.y), lf.w2z[p] = float(ps.w2.z);
     }
     const int done = ++rows;
     if (progress) {
@@ -106,6 +108,9 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
       progress(done);
     }
   });
+  // Depth of field measures x in pixels: no world axes (the screen axes are exact).
+  if (lf.effect == LightFieldEffect::Dof)
+    for (auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) v->clear();
   return lf;
 }
 

@@ -46,6 +46,8 @@ void SoftShadows::render_pixel(int x, int y, int l, double j1, double j2, PixelS
   double nn = dot(nl, h.n);
   if (std::fabs(nn) < 0.1) nn = nn < 0 ? -0.1 : 0.1;
   const Vec3 x1 = s_.a1 - nl * (dot(s_.a1, h.n) / nn), x2 = s_.a2 - nl * (dot(s_.a2, h.n) / nn);
+  out.w1 = s_.a1;  // x1 . a1 = 1, x2 . a1 = 0: D . a_i is D's x_i for D in the tangent plane
+  out.w2 = s_.a2;
   cam.screen_axis(h.p, x1, out.e1x, out.e1y);
   cam.screen_axis(h.p, x2, out.e2x, out.e2y);
 }

@@ -23,6 +23,7 @@ const FilterInfo& AafFilter::static_info() {
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
     i.required = {Role::Colour};
     i.deep_input = true;
+    i.lightfield_input = true;
     i.nonfinite_policy =
         "decode replaces non-finite sample values by 0 (counted in a note); a pixel whose weights sum to 0 (or "
         "non-finite) takes its own sample mean; non-finite slope bounds read as 0";
@@ -55,7 +56,7 @@ bool pass_along(const LightField& lf, const lf::Rule& r, const lf::Rejection& re
     int qx, qy;
     if (!lf::step_pixel(x, y, ux, uy, j, w, h, &qx, &qy)) continue;
     const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
-    const float t = rad > 0 ? float(j) / len : 0.0f;
+    const float t = lf::Displacement(lf).along(p, q, first ? 0 : 1, rad > 0 ? float(j) / len : 0.0f);
     if (rej.rejects(p, q, std::fabs(t), pixel_world)) continue;
     const double wx = lf::weight_x(t * t, r.inv2sx2);
     for (int ch = 0; ch < 3; ++ch) s[ch] += wx * src[q * 3 + std::size_t(ch)];

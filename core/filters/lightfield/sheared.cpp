@@ -25,6 +25,7 @@ const FilterInfo& ShearedFilter::static_info() {
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
     i.required = {Role::Colour};
     i.deep_input = true;
+    i.lightfield_input = true;
     i.nonfinite_policy =
         "decode replaces non-finite sample values by 0 (counted in a note); a pixel whose weights sum to 0 (or "
         "non-finite) takes its own sample mean; non-finite slope bounds read as 0";
@@ -101,6 +102,7 @@ void sheared_lightfield(const LightField& lf, const lf::Options& o, const Roi& r
   lf::Counts c;
   const std::vector<lf::Rule> rules = lf::pixel_rules(lf, o, lf::Mode::Sheared, roi, &c);
   const lf::WeightY wy(lf);
+  const lf::Displacement disp(lf);  // 1b, 2b: exact x_i from world positions when present
   const lf::Rejection rej(lf, o);
   const int w = lf.width, h = lf.height;
   const std::size_t n = lf.pixels(), spp = std::size_t(lf.spp());
@@ -192,6 +194,8 @@ void sheared_lightfield(const LightField& lf, const lf::Options& o, const Roi& r
                 wb[std::size_t(bi)] = wk;
                 wk *= a * step[std::size_t(bi)];
               }
+              for (int bi = 0; bi < B; ++bi)  // the light's edge (WeightY)
+                if (!(std::fabs(lf.y1[k] - bins.centre(bi)) <= wy.range)) wb[std::size_t(bi)] = 0;
             } else {
               for (int bi = 0; bi < B; ++bi) wb[std::size_t(bi)] = wy(lf.y1[k] - bins.centre(bi));
             }
@@ -227,7 +231,7 @@ void sheared_lightfield(const LightField& lf, const lf::Options& o, const Roi& r
           int qx, qy;
           if (!lf::step_pixel(x, y, ux, uy, j, w, h, &qx, &qy)) continue;
           const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
-          const float t = r.r1 > 0 ? float(j) / r.len1 : 0.0f;
+          const float t = disp.along(p, q, 0, r.r1 > 0 ? float(j) / r.len1 : 0.0f);
           if (rej.rejects(p, q, std::fabs(t), pixel_world)) continue;
           const float wx = lf::weight_x(t * t, r.inv2sx2);
           const Tent T = read_tent(bins, -r.eta * t);
@@ -277,7 +281,7 @@ void sheared_lightfield(const LightField& lf, const lf::Options& o, const Roi& r
           int qx, qy;
           if (!lf::step_pixel(x, y, ux, uy, j, w, h, &qx, &qy)) continue;
           const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
-          const float t = r.r2 > 0 ? float(j) / r.len2 : 0.0f;
+          const float t = disp.along(p, q, 1, r.r2 > 0 ? float(j) / r.len2 : 0.0f);
           if (rej.rejects(p, q, std::fabs(t), pixel_world)) continue;
           const float wx = lf::weight_x(t * t, r.inv2sx2);
           const Tent T = read_tent(bins, -r.eta * t);

@@ -23,6 +23,7 @@ const FilterInfo& Sheared4dFilter::static_info() {
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
     i.required = {Role::Colour};
     i.deep_input = true;
+    i.lightfield_input = true;
     i.nonfinite_policy =
         "decode replaces non-finite sample values by 0 (counted in a note); a pixel whose weights sum to 0 (or "
         "non-finite) takes its own sample mean; non-finite slope bounds read as 0";
@@ -46,6 +47,7 @@ void sheared4d_lightfield(const LightField& lf, const lf::Options& o, const Roi&
   const std::vector<lf::Rule> rules = lf::pixel_rules(lf, o, lf::Mode::Sheared, roi, &c);
   const lf::WeightY wy(lf);
   const lf::Rejection rej(lf, o);
+  const lf::Displacement disp(lf);
   const int w = lf.width, h = lf.height;
   const std::size_t spp = std::size_t(lf.spp());
   std::atomic<std::size_t> zero{0};
@@ -71,9 +73,11 @@ void sheared4d_lightfield(const LightField& lf, const lf::Options& o, const Roi&
       for (int qy = std::max(0, y - ry); qy <= std::min(h - 1, y + ry); ++qy)
         for (int qx = std::max(0, x - rx); qx <= std::min(w - 1, x + rx); ++qx) {
           const float dx = float(qx - x), dy = float(qy - y);
-          const float d1 = m11 * dx + m12 * dy, d2 = m21 * dx + m22 * dy;
-          if (std::fabs(d1) * r.len1 > float(r.r1) + 1e-3f || std::fabs(d2) * r.len2 > float(r.r2) + 1e-3f) continue;
+          const float l1 = m11 * dx + m12 * dy, l2 = m21 * dx + m22 * dy;
+          // The window is the screen's parallelogram; the weights take the exact displacement.
+          if (std::fabs(l1) * r.len1 > float(r.r1) + 1e-3f || std::fabs(l2) * r.len2 > float(r.r2) + 1e-3f) continue;
           const std::size_t q = std::size_t(qy) * std::size_t(w) + std::size_t(qx);
+          const float d1 = disp.along(p, q, 0, l1), d2 = disp.along(p, q, 1, l2);
           if (rej.rejects(p, q, std::sqrt(d1 * d1 + d2 * d2), pixel_world)) continue;
           const float wx = lf::weight_x(d1 * d1 + d2 * d2, r.inv2sx2);
           if (wx == 0) continue;
