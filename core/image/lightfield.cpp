@@ -41,6 +41,7 @@ const char* const kSampleChannels[] = {"R", "G", "B", "lf.y1", "lf.y2"};
 const char* const kPixelChannels[] = {"lf.smin", "lf.smax", "lf.e1x", "lf.e1y", "lf.e2x", "lf.e2y", "Z"};
 const char* const kGeometryChannels[] = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z"};
 const char* const kAxisChannels[] = {"lf.w1x", "lf.w1y", "lf.w1z", "lf.w2x", "lf.w2y", "lf.w2z"};
+const char* const kModChannels[] = {"lf.modR", "lf.modG", "lf.modB"};
 
 std::string at(int x, int y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
 
@@ -125,7 +126,14 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
                                             " samples; mcrecon:lf_l = " + std::to_string(l) + " needs exactly " +
                                             std::to_string(spp) + " in every pixel");
   }
+  int mc[3], mods = 0;
+  for (int i = 0; i < 3; ++i) mods += (mc[i] = deep.channel(kModChannels[i])) >= 0;
+  if (mods != 0 && mods != 3)
+    throw Error(Errc::MissingPass, "'" + path + "': light field has " + std::to_string(mods) +
+                                       " of the modulation channels lf.modR lf.modG lf.modB (all three or none)");
   lf.resize(deep.width, deep.height, l, present == 6);
+  if (mods == 3)
+    for (auto* v : {&lf.mod_r, &lf.mod_g, &lf.mod_b}) v->assign(lf.pixels(), 0.f);
   if (axes == 0)
     for (auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) v->clear();
 
@@ -189,6 +197,19 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
           geo_dst[i][p] = std::isfinite(v) ? v : (++repaired, 0.f);
         }
       }
+      if (mods == 3) {
+        float* mod_dst[3] = {lf.mod_r.data(), lf.mod_g.data(), lf.mod_b.data()};
+        for (int i = 0; i < 3; ++i) {
+          const float v = deep.values[mc[i]][s0];
+          if (!std::isfinite(v) || v < 0) {
+            std::ostringstream os;
+            os << "'" << path << "': " << at(x, y) << " has " << kModChannels[i] << " = " << v
+               << " (the modulation must be finite and not negative)";
+            throw Error(Errc::ReadFailed, os.str());
+          }
+          mod_dst[i][p] = v;
+        }
+      }
       if (axes == 6) {
         float* axis_dst[6] = {lf.w1x.data(), lf.w1y.data(), lf.w1z.data(), lf.w2x.data(), lf.w2y.data(), lf.w2z.data()};
         for (int i = 0; i < 6; ++i) {
@@ -247,6 +268,8 @@ DeepSamples encode_lightfield(const LightField& lf) {
     for (const char* c : kGeometryChannels) d.channel_names.push_back(c);
   if (lf.has_world_axes())
     for (const char* c : kAxisChannels) d.channel_names.push_back(c);
+  if (lf.has_modulation())
+    for (const char* c : kModChannels) d.channel_names.push_back(c);
   d.values.reserve(d.channel_names.size());
   for (const auto* v : {&lf.r, &lf.g, &lf.b, &lf.y1, &lf.y2}) d.values.push_back(*v);
   auto repeat = [&](const std::vector<float>& per_pixel) {
@@ -260,6 +283,8 @@ DeepSamples encode_lightfield(const LightField& lf) {
     for (const auto* v : {&lf.px, &lf.py, &lf.pz, &lf.nx, &lf.ny, &lf.nz}) repeat(*v);
   if (lf.has_world_axes())
     for (const auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) repeat(*v);
+  if (lf.has_modulation())
+    for (const auto* v : {&lf.mod_r, &lf.mod_g, &lf.mod_b}) repeat(*v);
   d.attributes["mcrecon:lightfield"] = effect_name(lf.effect);
   d.attributes["mcrecon:lf_l"] = std::to_string(lf.l);
   std::ostringstream yr, sy;

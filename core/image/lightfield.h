@@ -57,19 +57,26 @@ struct LightField {
   // exact under perspective, instead of the screen linearisation e1, e2 (which is off by 5% at
   // 5 pixels on an oblique ground, enough to shear a shadow wrongly at 16).
   std::vector<float> w1x, w1y, w1z, w2x, w2y, w2z;
+  // Modulation (empty when absent): what the pixel would be with nothing in the way (soft
+  // shadows: the unoccluded direct light, RGB). The filters then shear f / mod, the visibility
+  // (Mehta et al. 2012, Yan et al. 3.1: the sheared spectrum is the visibility's), and multiply
+  // the result by the pixel's mod: the shading's own change across a 32-pixel window is not
+  // carried from a neighbour into the pixel (it left bright and dark rings around shadows).
+  std::vector<float> mod_r, mod_g, mod_b;
 
   int spp() const { return l * l; }
   std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
   std::size_t samples() const { return pixels() * std::size_t(spp()); }
   bool has_geometry() const { return !px.empty() && !nx.empty(); }
   bool has_world_axes() const { return has_geometry() && !w1x.empty(); }
+  bool has_modulation() const { return !mod_r.empty(); }
   // Allocates every array for width x height x l*l (geometry and world axes too when `geometry`).
   void resize(int w, int h, int l_, bool geometry);
 };
 
 // The deep EXR form: per-sample channels R G B lf.y1 lf.y2, and per-pixel values repeated on
 // each sample: lf.smin lf.smax lf.e1x lf.e1y lf.e2x lf.e2y Z, optionally P.X P.Y P.Z N.X N.Y N.Z
-// and with them lf.w1x lf.w1y lf.w1z lf.w2x lf.w2y lf.w2z;
+// and with them lf.w1x lf.w1y lf.w1z lf.w2x lf.w2y lf.w2z; optionally lf.modR lf.modG lf.modB;
 // header attributes mcrecon:lightfield (effect), mcrecon:lf_l, mcrecon:lf_y_range,
 // mcrecon:lf_sigma_y.
 bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield

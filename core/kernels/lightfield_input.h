@@ -15,6 +15,7 @@ ParamSpec max_width_param();
 ParamSpec reject_param();
 ParamSpec normal_degrees_param();
 ParamSpec smooth_radius_param();
+ParamSpec bounds_radius_param();
 ParamSpec fallback_param();
 ParamSpec mu_param(bool fallback_only);
 ParamSpec bins_param();
@@ -25,6 +26,9 @@ Options options_from(const ParamSet& params);
 // The frame's light field: throws Error(MissingPass) naming `filter` and the file when the frame
 // has no deep buffer or one without the light-field attribute (README: the light-field
 // convention), Error(SizeMismatch) when it is not the frame's size; decode's errors pass through.
+// With a modulation (image/lightfield.h), the samples come back divided by their pixel's mod
+// (0 where the mod is 0): what the filters shear; remodulate() multiplies the result back.
 LightField lightfield_input(const Frame& frame, const std::string& filter, std::size_t* nonfinite_values);
+void remodulate(const LightField& lf, const Roi& roi, Image& out);
 
 }  // namespace mcr::lf

@@ -15,7 +15,7 @@ float finite_or_zero(float v) { return std::isfinite(v) ? v : 0.0f; }
 
 // Bounds after the soft-shadow smoothing (sec. 5): a pixel with lo == hi == 0 takes the
 // smallest lo and largest hi of the pixels in its window whose bounds are not both 0.
-void smoothed_bounds(const LightField& lf, int radius, std::vector<float>& lo, std::vector<float>& hi,
+void smoothed_bounds(const LightField& lf, int radius, int bounds_radius, std::vector<float>& lo, std::vector<float>& hi,
                      std::vector<unsigned char>& took) {
   const std::size_t n = lf.pixels();
   lo.resize(n);
@@ -25,6 +25,24 @@ void smoothed_bounds(const LightField& lf, int radius, std::vector<float>& lo, s
     const float a = finite_or_zero(lf.smin[p]), b = finite_or_zero(lf.smax[p]);
     lo[p] = std::min(a, b);
     hi[p] = std::max(a, b);
+  }
+  if (bounds_radius < 0) bounds_radius = lf.effect == LightFieldEffect::SoftShadows ? radius : 0;
+  if (bounds_radius > 0) {
+    // A pixel's few samples see part of what its neighbours see: the bounds of the window.
+    const std::vector<float> lo0 = lo, hi0 = hi;
+    const int w = lf.width, h = lf.height;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const std::size_t p = std::size_t(y) * std::size_t(w) + std::size_t(x);
+        if (lo0[p] == 0 && hi0[p] == 0) continue;
+        for (int yy = std::max(0, y - bounds_radius); yy <= std::min(h - 1, y + bounds_radius); ++yy)
+          for (int xx = std::max(0, x - bounds_radius); xx <= std::min(w - 1, x + bounds_radius); ++xx) {
+            const std::size_t q = std::size_t(yy) * std::size_t(w) + std::size_t(xx);
+            if (lo0[q] == 0 && hi0[q] == 0) continue;
+            lo[p] = std::min(lo[p], lo0[q]);
+            hi[p] = std::max(hi[p], hi0[q]);
+          }
+      }
   }
   if (lf.effect != LightFieldEffect::SoftShadows || radius <= 0) return;
   const std::vector<float> lo0 = lo, hi0 = hi;
@@ -88,7 +106,7 @@ std::vector<Rule> pixel_rules(const LightField& lf, const Options& o, Mode mode,
                                               "x" + std::to_string(lf.l) + " samples");
   std::vector<float> lo, hi;
   std::vector<unsigned char> took;
-  smoothed_bounds(lf, o.smooth_radius, lo, hi, took);
+  smoothed_bounds(lf, o.smooth_radius, o.bounds_radius, lo, hi, took);
   const std::size_t n = lf.pixels();
   const int cap = std::max(0, o.max_width / 2);
   const double sy = lf.sigma_y;
@@ -164,6 +182,7 @@ void own_mean(const LightField& lf, const WeightY& wy, std::size_t p, float* rgb
 }
 
 bool converged(const LightField& lf, std::size_t p) {
+  if (lf.spp() < 2) return false;  // one sample says nothing of its pixel's spread
   const std::size_t k0 = p * std::size_t(lf.spp()), k1 = k0 + std::size_t(lf.spp());
   for (std::size_t k = k0 + 1; k < k1; ++k)
     if (lf.r[k] != lf.r[k0] || lf.g[k] != lf.g[k0] || lf.b[k] != lf.b[k0]) return false;
@@ -184,7 +203,15 @@ bool Rejection::rejects(std::size_t p, std::size_t q, float dist, float pixel_wo
   if (np > 0 && nq > 0 && dot < cos_max_ * std::sqrt(np * nq)) return true;
   const float dx = lf.px[q] - lf.px[p], dy = lf.py[q] - lf.py[p], dz = lf.pz[q] - lf.pz[p];
   const float gap = std::sqrt(dx * dx + dy * dy + dz * dz);
-  return gap > 2.0f * dist + pixel_world;
+  if (gap > 2.0f * dist + pixel_world) return true;
+  // Off P's tangent plane: another receiver (a box's top seen beside the ground at the same
+  // screen distance) shears along other lines. A pixel's size plus a tenth of the gap allows a
+  // gently curved receiver.
+  if (np > 0) {
+    const float off = std::fabs(dx * lf.nx[p] + dy * lf.ny[p] + dz * lf.nz[p]) / std::sqrt(np);
+    if (off > pixel_world + 0.1f * gap) return true;
+  }
+  return false;
 }
 
 std::string counts_note(const std::string& who, const Counts& c, bool sheared) {

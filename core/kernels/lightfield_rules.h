@@ -31,6 +31,8 @@ struct Options {
   bool reject = true;         // reject neighbours across geometry edges (soft shadows, gi with geometry)
   float normal_degrees = 20;  // ... whose normal differs by more than this
   int smooth_radius = 2;      // soft shadows: slope smoothing window (2 = 5x5); 0 = off
+  int bounds_radius = -1;     // every pixel's bounds widened to those of its (2r+1)^2 window; 0 = own;
+                              // -1 = smooth_radius for soft shadows, 0 otherwise
   bool fallback_aaf = true;   // lo * hi <= 0 (not both 0): the axis-aligned rule (else own mean)
   float mu = 1;               // the axis-aligned rule's mu
   int bins = 16;              // sheared (factored): bins over b and y2
@@ -87,16 +89,18 @@ struct WeightY {
 
 inline float weight_x(float d2, float inv2sx2) { return std::exp(-d2 * inv2sx2); }
 
+
 // The pixel's own sum over its samples of f w_y(y1) w_y(y2) / the sum of the weights (their
 // plain mean when every weight is 0). rgb: 3 floats.
 void own_mean(const LightField& lf, const WeightY& wy, std::size_t p, float* rgb);
-// All l*l samples of pixel p carry the same colour.
+// All l*l samples of pixel p carry the same colour (never with l = 1).
 bool converged(const LightField& lf, std::size_t p);
 
 // Neighbour rejection (soft shadows and gi with geometry; inactive otherwise): Q is not used
 // for P when their normals differ by more than normal_degrees, or when |pos_Q - pos_P| >
 // 2 dist + pixel_world, dist the displacement's length in x units (world) and pixel_world
-// the world size of one pixel at P (1 / min(|e1|, |e2|)). A zero normal rejects nothing by angle.
+// the world size of one pixel at P (1 / min(|e1|, |e2|)), or when Q lies off P's tangent plane
+// by more than pixel_world + a tenth of their distance. A zero normal rejects nothing.
 class Rejection {
  public:
   Rejection(const LightField& lf, const Options& o);

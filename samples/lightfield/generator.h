@@ -22,6 +22,7 @@ struct PixelSamples {
   double depth = 0;             // along the view ray to the receiver
   Vec3 p, n;                    // receiver position and unit normal
   Vec3 w1, w2;                  // world dual axes: a receiver displacement D is D . w_i in x units
+  Vec3 mod;                     // soft shadows: the unoccluded light (the value with nothing in the way)
   void reset(int spp);
   // Widens [smin, smax] by one sample's slope (the first one sets both).
   void add_slope(double s);

@@ -18,7 +18,7 @@ void PixelSamples::reset(int spp) {
   has_slope = false;
   e1x = e1y = e2x = e2y = 0;
   depth = 0;
-  p = n = w1 = w2 = Vec3();
+  p = n = w1 = w2 = mod = Vec3();
 }
 
 void PixelSamples::add_slope(double s) {
@@ -69,6 +69,8 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
   lf.y_range = float(gen.y_range());
   lf.sigma_y = float(gen.sigma_y());
   const std::size_t spp = std::size_t(l) * std::size_t(l);
+  if (lf.effect == LightFieldEffect::SoftShadows)
+    for (auto* v : {&lf.mod_r, &lf.mod_g, &lf.mod_b}) v->assign(lf.pixels(), 0.f);
   std::atomic<int> rows{0};
   std::mutex report;
   parallel_rows(0, gen.height(), nthreads, [&](int y) {
@@ -99,6 +101,7 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
       lf.nx[p] = float(ps.n.x);
       lf.ny[p] = float(ps.n.y);
       lf.nz[p] = float(ps.n.z);
+      if (lf.has_modulation()) lf.mod_r[p] = float(ps.mod.x), lf.mod_g[p] = float(ps.mod.y), lf.mod_b[p] = float(ps.mod.z);
       lf.w1x[p] = float(ps.w1.x), lf.w1y[p] = float(ps.w1.y), lf.w1z[p] = float(ps.w1.z);
       lf.w2x[p] = float(ps.w2.x), lf.w2y[p] = float(ps.w2.y), lf.w2z[p] = float(ps.w2.z);
     }

@@ -40,6 +40,27 @@ void SoftShadows::render_pixel(int x, int y, int l, double j1, double j2, PixelS
       }
       out.value[k] = albedo * (s_.radiance / M_PI * cos_r * cos_l / (d1 * d1));
     }
+  // The modulation: the same light with nothing in the way, Gaussian-weighted over a 16 x 16
+  // grid of the light (no rays: smooth, so the grid is converged), what the filters multiply
+  // the sheared visibility by.
+  {
+    const int g = 16;
+    const double sigma = sigma_y();
+    Vec3 sum;
+    double wsum = 0;
+    for (int j = 0; j < g; ++j)
+      for (int i = 0; i < g; ++i) {
+        const double u1 = -L + (i + 0.5) * 2 * L / g, u2 = -L + (j + 0.5) * 2 * L / g;
+        const double wg = std::exp(-(u1 * u1 + u2 * u2) / (2 * sigma * sigma));
+        wsum += wg;
+        const Vec3 to_light = s_.light_centre + s_.a1 * u1 + s_.a2 * u2 - h.p;
+        const double d1 = length(to_light);
+        const Vec3 w = to_light / d1;
+        const double cos_r = dot(h.n, w), cos_l = -dot(nl, w);
+        if (cos_r > 0 && cos_l > 0) sum = sum + albedo * (wg * s_.radiance / M_PI * cos_r * cos_l / (d1 * d1));
+      }
+    out.mod = sum / wsum;
+  }
   // x_i: the receiver displacement in its tangent plane that moves one unit along a_i when
   // projected along the light normal: a_i + t nl with (a_i + t nl) . n = 0. A receiver nearly
   // perpendicular to the light has no such finite displacement: the cosine is held at 0.1.

@@ -127,3 +127,48 @@ TEST(LightFieldEdges, WorldAxesGiveTheExactDisplacementUnderPerspective) {
 
 }  // namespace
 }  // namespace mcr
+
+#include "kernels/lightfield_input.h"
+
+namespace mcr {
+namespace {
+
+// The same shadow edge under shading that changes across the window (S = 1 + 0.5 sin(0.2 X)):
+// with the modulation (S at each pixel) the filter shears the visibility alone and multiplies S
+// back; without it, a neighbour's shading is carried into the pixel.
+TEST(LightFieldEdges, TheModulationKeepsTheShadingOutOfTheShear) {
+  auto shading = [](double X1) { return 1.0 + 0.5 * std::sin(0.2 * X1); };
+  LightField lf = shadow_edge(8);
+  const Image vis_exact = shadow_edge_exact(lf);
+  Image exact(lf.width, lf.height, 3);
+  const std::size_t spp = std::size_t(lf.spp());
+  lf.mod_r.resize(lf.pixels()), lf.mod_g.resize(lf.pixels()), lf.mod_b.resize(lf.pixels());
+  for (std::size_t p = 0; p < lf.pixels(); ++p) {
+    double X1, X2;
+    testutil::x_units(lf, p, &X1, &X2);
+    const float S = float(shading(X1));
+    for (std::size_t k = p * spp; k < (p + 1) * spp; ++k) lf.r[k] *= S, lf.g[k] *= S, lf.b[k] *= S;
+    lf.mod_r[p] = S, lf.mod_g[p] = 0.8f * S, lf.mod_b[p] = 0.6f * S;  // the unoccluded light, as the generator writes
+    for (int c = 0; c < 3; ++c) exact.data()[p * 3 + std::size_t(c)] = vis_exact.data()[p * 3 + std::size_t(c)] * S;
+  }
+  auto filtered = [&](bool with_mod) {
+    LightField in = lf;
+    if (!with_mod) in.mod_r.clear(), in.mod_g.clear(), in.mod_b.clear();
+    Frame frame;
+    frame.width = in.width, frame.height = in.height, frame.path = "edge.exr";
+    frame.deep = std::make_shared<DeepSamples>(encode_lightfield(in));
+    const LightField dec = lf::lightfield_input(frame, "sheared", nullptr);
+    Image out(in.width, in.height, 3);
+    lf::Options o;
+    sheared_lightfield(dec, o, Roi::all(in.width, in.height), 0, out, nullptr);
+    lf::remodulate(dec, Roi::all(in.width, in.height), out);
+    return out;
+  };
+  const double with = testutil::rms_diff(exact, filtered(true), 2), without = testutil::rms_diff(exact, filtered(false), 2);
+  std::printf("shading across the window: with the modulation %.4f, without %.4f\n", with, without);
+  EXPECT_LT(with, 0.015);
+  EXPECT_LT(with, without / 2);
+}
+
+}  // namespace
+}  // namespace mcr

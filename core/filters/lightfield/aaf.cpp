@@ -17,7 +17,7 @@ const FilterInfo& AafFilter::static_info() {
     i.summary = "Axis-aligned filtering of light-field samples (deep EXR): each pixel's samples integrated over y, "
                 "then a spatial Gaussian from the slope bounds";
     i.reference = "Mehta et al. 2012 (sigma_x from the minimum slope, mu); Yan et al. 2015 sec. 3.1, 5";
-    i.params = with_preparation_params({lf::max_width_param(), lf::mu_param(false), lf::smooth_radius_param(),
+    i.params = with_preparation_params({lf::max_width_param(), lf::mu_param(false), lf::smooth_radius_param(), lf::bounds_radius_param(),
                                         lf::reject_param(), lf::normal_degrees_param()},
                                        PrepSteps::none());
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
@@ -123,8 +123,9 @@ void AafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Ima
   const LightField lf = lf::lightfield_input(frame, info().name, &nonfinite);
   lf::Counts c;
   aaf_lightfield(lf, lf::options_from(params_), roi, nthreads, out, &c);
+  lf::remodulate(lf, roi, out);
   note(lf::counts_note(info().name, c, false));
-  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values read as 0");
+  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values replaced by their pixel's mean");
 }
 
 }  // namespace mcr

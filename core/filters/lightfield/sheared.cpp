@@ -19,7 +19,7 @@ const FilterInfo& ShearedFilter::static_info() {
                 "indirect light, factored into four 1D steps";
     i.reference = "Yan et al. 2015, eq. 9-15; sec. 5 (16 bins, 32-pixel cap, slope smoothing, axis-aligned fallback)";
     i.params = with_preparation_params({lf::max_width_param(), lf::bins_param(), lf::fallback_param(),
-                                        lf::mu_param(true), lf::smooth_radius_param(), lf::reject_param(),
+                                        lf::mu_param(true), lf::smooth_radius_param(), lf::bounds_radius_param(), lf::reject_param(),
                                         lf::normal_degrees_param()},
                                        PrepSteps::none());
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
@@ -313,8 +313,9 @@ void ShearedFilter::run(const Frame& frame, const Image& colour, const Roi& roi,
   const LightField lf = lf::lightfield_input(frame, info().name, &nonfinite);
   lf::Counts c;
   sheared_lightfield(lf, lf::options_from(params_), roi, nthreads, out, &c);
+  lf::remodulate(lf, roi, out);
   note(lf::counts_note(info().name, c, true));
-  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values read as 0");
+  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values replaced by their pixel's mean");
 }
 
 }  // namespace mcr

@@ -18,7 +18,7 @@ const FilterInfo& Sheared4dFilter::static_info() {
                 "indirect light; the slow reference of 'sheared'";
     i.reference = "Yan et al. 2015, eq. 3-5, 9; sec. 5 (slope smoothing, axis-aligned fallback)";
     i.params = with_preparation_params({lf::max_width_param(), lf::fallback_param(), lf::mu_param(true),
-                                        lf::smooth_radius_param(), lf::reject_param(), lf::normal_degrees_param()},
+                                        lf::smooth_radius_param(), lf::bounds_radius_param(), lf::reject_param(), lf::normal_degrees_param()},
                                        PrepSteps::none());
     i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
     i.required = {Role::Colour};
@@ -111,8 +111,9 @@ void Sheared4dFilter::run(const Frame& frame, const Image& colour, const Roi& ro
   const LightField lf = lf::lightfield_input(frame, info().name, &nonfinite);
   lf::Counts c;
   sheared4d_lightfield(lf, lf::options_from(params_), roi, nthreads, out, &c);
+  lf::remodulate(lf, roi, out);
   note(lf::counts_note(info().name, c, true));
-  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values read as 0");
+  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values replaced by their pixel's mean");
 }
 
 }  // namespace mcr
