@@ -59,7 +59,12 @@ class LightFieldCli(unittest.TestCase):
                 spec, ch = read_deep(self.render(scene + ".exr", "--scene", scene, "--spp", 9))
                 self.assertTrue(spec.deep)
                 self.assertEqual((spec.width, spec.height), (W, H))
-                self.assertEqual(set(spec.channelnames), CHANNELS)
+                extra = set()
+                if scene != "dof":  # world axes (x in world units), and the unoccluded light for soft shadows
+                    extra |= {"lf.w1x", "lf.w1y", "lf.w1z", "lf.w2x", "lf.w2y", "lf.w2z"}
+                if scene == "soft_shadows":
+                    extra |= {"lf.modR", "lf.modG", "lf.modB"}
+                self.assertEqual(set(spec.channelnames), CHANNELS | extra)
                 self.assertEqual(ch["R"].shape, (W * H, 9))
                 self.assertEqual(spec.getattribute("mcrecon:lightfield"), effect)
                 self.assertEqual(int(spec.getattribute("mcrecon:lf_l")), 3)
