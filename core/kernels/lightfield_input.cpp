@@ -97,4 +97,16 @@ void remodulate(const LightField& lf, const Roi& roi, Image& out) {
     }
 }
 
+std::vector<std::string> run_on_frame(const Frame& frame, const std::string& filter, const Options& o, const Roi& roi,
+                                      int nthreads, Image& out, Core core, bool sheared) {
+  std::size_t nonfinite = 0;
+  const LightField lf = lightfield_input(frame, filter, &nonfinite);
+  Counts c;
+  core(lf, o, roi, nthreads, out, &c);
+  remodulate(lf, roi, out);
+  std::vector<std::string> notes = {counts_note(filter, c, sheared)};
+  if (nonfinite) notes.push_back(filter + ": " + std::to_string(nonfinite) + " non-finite sample values replaced by their pixel's mean");
+  return notes;
+}
+
 }  // namespace mcr::lf

@@ -3,6 +3,7 @@
 // name, range and help in every table) and the decoded light field of a frame.
 #include <cstddef>
 #include <string>
+#include <vector>
 
 #include "image/lightfield.h"
 #include "image/pass.h"
@@ -30,5 +31,12 @@ Options options_from(const ParamSet& params);
 // (0 where the mod is 0): what the filters shear; remodulate() multiplies the result back.
 LightField lightfield_input(const Frame& frame, const std::string& filter, std::size_t* nonfinite_values);
 void remodulate(const LightField& lf, const Roi& roi, Image& out);
+
+// What each light-field filter's run() does around its core: decode (and demodulate) the
+// frame's light field, run `core`, multiply the modulation back; returns the notes (the
+// counts, the non-finite values replaced).
+using Core = void (*)(const LightField&, const Options&, const Roi&, int, Image&, Counts*);
+std::vector<std::string> run_on_frame(const Frame& frame, const std::string& filter, const Options& o, const Roi& roi,
+                                      int nthreads, Image& out, Core core, bool sheared);
 
 }  // namespace mcr::lf

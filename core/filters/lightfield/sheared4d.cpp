@@ -107,13 +107,8 @@ void sheared4d_lightfield(const LightField& lf, const lf::Options& o, const Roi&
 
 void Sheared4dFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
   (void)colour;
-  std::size_t nonfinite = 0;
-  const LightField lf = lf::lightfield_input(frame, info().name, &nonfinite);
-  lf::Counts c;
-  sheared4d_lightfield(lf, lf::options_from(params_), roi, nthreads, out, &c);
-  lf::remodulate(lf, roi, out);
-  note(lf::counts_note(info().name, c, true));
-  if (nonfinite) note(info().name + ": " + std::to_string(nonfinite) + " non-finite sample values replaced by their pixel's mean");
+  for (std::string& n : lf::run_on_frame(frame, info().name, lf::options_from(params_), roi, nthreads, out, &sheared4d_lightfield, true))
+    note(std::move(n));
 }
 
 }  // namespace mcr
