@@ -27,7 +27,7 @@ json to_json(const FilterInfo& info) {
   for (Role r : info.required) req.push_back(role_name(r));
   for (Role r : info.optional) opt.push_back(role_name(r));
   return {{"name", info.name},     {"summary", info.summary},   {"reference", info.reference},
-          {"temporal", info.temporal}, {"input", info.lightfield_input ? "lightfield" : info.deep_input ? "deep" : "image"}, {"required_passes", req}, {"optional_passes", opt},
+          {"temporal", info.temporal}, {"input", info.deep_input ? "deep" : "image"}, {"lightfield", info.lightfield_input}, {"required_passes", req}, {"optional_passes", opt},
           {"nonfinite_policy", info.nonfinite_policy}, {"parameters", params}};
 }
 

@@ -72,7 +72,8 @@ py::dict info_to_dict(const mcr::FilterInfo& info) {
   d["summary"] = info.summary;
   d["reference"] = info.reference;
   d["temporal"] = info.temporal;
-  d["input"] = info.lightfield_input ? "lightfield" : info.deep_input ? "deep" : "image";
+  d["input"] = info.deep_input ? "deep" : "image";
+  d["lightfield"] = info.lightfield_input;
   d["required_passes"] = req;
   d["optional_passes"] = opt;
   d["nonfinite_policy"] = info.nonfinite_policy;

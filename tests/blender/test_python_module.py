@@ -221,9 +221,11 @@ def test_needs_match_info_and_settings(tmp):
         present = set(info["roles"])
         assert [f["name"] for f in info["filters"]] == mcrecon.filter_names()
         deep = {f["name"] for f in mcrecon.filters() if f["input"] == "deep"}
+        lightfield = {f["name"] for f in mcrecon.filters() if f["lightfield"]}
         for entry in info["filters"]:
             n = mcrecon.needs(entry["name"])
-            flat = ["per-sample (deep) input"] if entry["name"] in deep and not info["deep"] else []
+            flat = ["light-field (deep EXR) input"] if entry["name"] in lightfield else \
+                ["per-sample (deep) input"] if entry["name"] in deep and not info["deep"] else []
             assert entry["missing"] == [r for r in n["required"] if r not in present] + flat, (path, entry, n)
             assert entry["uses"] == [r for r in n["optional"] if r in present], (path, entry, n)
             assert entry["can_run"] == (not entry["missing"])
