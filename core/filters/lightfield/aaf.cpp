@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cmath>
 
+#include "filters/lightfield/lightfield_info.h"
 #include "kernels/lightfield_input.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -20,13 +21,7 @@ const FilterInfo& AafFilter::static_info() {
     i.params = with_preparation_params({lf::max_width_param(), lf::mu_param(false), lf::smooth_radius_param(), lf::bounds_radius_param(),
                                         lf::reject_param(), lf::normal_degrees_param()},
                                        PrepSteps::none());
-    i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
-    i.required = {Role::Colour};
-    i.deep_input = true;
-    i.lightfield_input = true;
-    i.nonfinite_policy =
-        "decode replaces non-finite sample values by 0 (counted in a note); a pixel whose weights sum to 0 (or "
-        "non-finite) takes its own sample mean; non-finite slope bounds read as 0";
+    lf::light_field_info(i);
     return i;
   }();
   return info;

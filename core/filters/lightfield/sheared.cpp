@@ -5,6 +5,7 @@
 #include <cmath>
 #include <numeric>
 
+#include "filters/lightfield/lightfield_info.h"
 #include "kernels/lightfield_input.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -22,13 +23,7 @@ const FilterInfo& ShearedFilter::static_info() {
                                         lf::mu_param(true), lf::smooth_radius_param(), lf::bounds_radius_param(), lf::reject_param(),
                                         lf::normal_degrees_param()},
                                        PrepSteps::none());
-    i.steps = PrepSteps::none();  // the flat-image steps mean nothing per sample
-    i.required = {Role::Colour};
-    i.deep_input = true;
-    i.lightfield_input = true;
-    i.nonfinite_policy =
-        "decode replaces non-finite sample values by 0 (counted in a note); a pixel whose weights sum to 0 (or "
-        "non-finite) takes its own sample mean; non-finite slope bounds read as 0";
+    lf::light_field_info(i);
     return i;
   }();
   return info;
