@@ -24,6 +24,7 @@ import textwrap
 import unittest
 
 import numpy as np
+import OpenImageIO as oiio
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mcrecon_testutil as tu  # noqa: E402
@@ -178,6 +179,38 @@ class LimitsTest(unittest.TestCase):
         # Through the plugin this made oiiotool allocate 160 GB and abort.
         f = self.hostile(100000, 100000)
         self.assert_refused_everywhere(f, "100000x100000x4 float (160 GB)", "file can hold at most")
+
+    def test_deep_chunk_claiming_a_gigabyte(self):
+        # Found by fuzz_read_deep: a 1 KB deep file whose chunk header claims 973 MB of packed
+        # samples made OpenEXR allocate them before it found the file's end.
+        src = self.path("deep_ok.exr")
+        spec = oiio.ImageSpec(4, 3, 4, "float")
+        spec.channelnames = ("R", "G", "B", "Z")
+        spec.z_channel = 3
+        spec.deep = True
+        spec.attribute("compression", "zips")
+        dd = oiio.DeepData()
+        dd.init(spec)
+        for p in range(12):
+            dd.set_samples(p, 2)
+        out = oiio.ImageOutput.create(src)
+        self.assertTrue(out.open(src, spec) and out.write_deep_image(dd), out.geterror())
+        out.close()
+        data = bytearray(open(src, "rb").read())
+        # The first chunk: its offset is the first entry of the table after the header; its
+        # header is the scanline (4 bytes), then the packed table size and the packed data size.
+        # Walk the attributes to the header's end (an empty name); the offset table follows.
+        pos = 8
+        while data[pos] != 0:
+            name_end = data.index(0, pos)
+            type_end = data.index(0, name_end + 1)
+            size = int.from_bytes(data[type_end + 1:type_end + 5], "little")
+            pos = type_end + 5 + size
+        first = int.from_bytes(data[pos + 1:pos + 9], "little")
+        data[first + 12:first + 20] = (973078708).to_bytes(8, "little")
+        f = self.path("deep_chunk_1gb.exr")
+        open(f, "wb").write(bytes(data))
+        self.assert_refused_everywhere(f, "deep chunk 0 claims", "973078708")
 
     def test_max_memory_lowers_and_raises_the_limit(self):
         legit = self.path("legit.exr")
