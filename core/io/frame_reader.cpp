@@ -223,6 +223,7 @@ RawImage read_raw(const std::string& path) {
   try {
     if (spec.deep) {
       check_deep_samples(path, spec.nchannels, budget);
+      check_deep_chunk_sizes(path);
       read_deep(*in, raw, path);
     } else {
       read_parts(*in, raw, path);

@@ -356,11 +356,17 @@ void check_exr_part(const std::string& path, const ExrPartHeader& part, const st
 
 }  // namespace
 
-// A single-part deep file's chunks, after its header: each chunk's header claims the unpacked
+namespace {
+
+// A single-part deep scanline file's chunks, after its header: each chunk's header claims the unpacked
 // size of its samples, which OpenEXR allocates before it reads them (a 1 KB file made it allocate
 // 973 MB). No chunk may claim more than its packed bytes can expand to, or lie past the file.
 void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
-  if (part.chunk_count < 0) return;  // OpenEXR refuses a deep file without it
+  // Scanline files whose chunk count agrees with their window (1 line a chunk, 16 for zip);
+  // any other header is refused by the size checks that follow, with their own message.
+  if (part.tiled || !part.has_window || part.chunk_count < 0) return;
+  const std::int64_t lines = part.compression == 3 ? 16 : 1;
+  if (part.chunk_count != (part.height + lines - 1) / lines) return;
   if (std::uint64_t(part.chunk_count) > r.left() / 8)
     r.fail("its chunkCount " + std::to_string(part.chunk_count) + " needs a " +
            std::to_string(std::uint64_t(part.chunk_count) * 8) + "-byte offset table, more than the file holds");
@@ -368,7 +374,7 @@ void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
   for (auto& o : offsets) o = std::uint64_t(r.u32("the chunk offset table")) | std::uint64_t(r.u32("the chunk offset table")) << 32;
   const std::uint64_t size = r.pos() + r.left();
   const double expand = max_expansion("openexr", exr_compression_name(part.compression));
-  const std::uint64_t head = part.tiled ? 16 : 4;  // tile coordinates and level, or the scanline
+  const std::uint64_t head = 4;  // the chunk's first scanline
   for (std::size_t k = 0; k < offsets.size(); ++k) {
     const std::string chunk = "deep chunk " + std::to_string(k);
     if (offsets[k] > size || size - offsets[k] < head + 24) continue;  // OpenEXR reports a bad offset itself
@@ -389,7 +395,7 @@ void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
   }
 }
 
-void check_exr_header_sizes(const std::string& path) {
+void scan_exr(const std::string& path, bool deep_chunks) {
   struct stat st {};
   if (::stat(path.c_str(), &st) != 0) return;  // require_regular_file reports that
   const std::uint64_t size = std::uint64_t(st.st_size);
@@ -423,11 +429,17 @@ void check_exr_header_sizes(const std::string& path) {
     part.tiled = multipart || deep ? part.type == "tiledimage" || part.type == "deeptile" : single_tiled;
     check_exr_part(path, part, where, size);
     if (!multipart) {
-      if (deep) check_deep_chunks(r, part);
+      if (deep && deep_chunks) check_deep_chunks(r, part);
       return;
     }
   }
 }
+
+}  // namespace
+
+void check_exr_header_sizes(const std::string& path) { scan_exr(path, false); }
+
+void check_deep_chunk_sizes(const std::string& path) { scan_exr(path, true); }
 
 InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path) {
   const OIIO::ImageSpec first = in.spec();  // a copy: seek_subimage changes in.spec()
