@@ -41,9 +41,8 @@ nlohmann::json deep_report(const DeepSamples& d) {
 }
 
 // A light field (README: the light-field convention): effect, sampling, slopes, work to do.
-nlohmann::json lightfield_report(const DeepSamples& d, const std::string& path) {
-  std::size_t repaired = 0;
-  const LightField lf = decode_lightfield(d, path, &repaired);
+nlohmann::json lightfield_report(const LightField& lf) {
+  const std::size_t repaired = lf.nonfinite_replaced;
   const LightFieldSummary s = summarize(lf);
   return {{"effect", effect_name(lf.effect)}, {"l", lf.l}, {"spp", lf.spp()}, {"y_range", lf.y_range},
           {"sigma_y", lf.sigma_y}, {"slope_min", s.slope_min}, {"slope_max", s.slope_max},
@@ -99,7 +98,7 @@ int run_info(const InfoArgs& a) {
   if (frame.deep) {
     j["deep_samples"] = frame.deep->total_samples();
     j["deep_buffer"] = deep_report(*frame.deep);
-    if (is_lightfield(*frame.deep)) j["lightfield"] = lightfield_report(*frame.deep, frame.path);
+    if (frame.lightfield) j["lightfield"] = lightfield_report(*frame.lightfield);
   }
   if (a.json) {
     std::cout << j.dump(2) << "\n";

@@ -221,6 +221,7 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
         }
       }
     }
+  lf.nonfinite_replaced = repaired;
   if (nonfinite_values) *nonfinite_values = repaired;
   return lf;
 }

@@ -64,6 +64,8 @@ struct LightField {
   // carried from a neighbour into the pixel (it left bright and dark rings around shadows).
   std::vector<float> mod_r, mod_g, mod_b;
 
+  std::size_t nonfinite_replaced = 0;     // sample values decode replaced (non-finite)
+
   int spp() const { return l * l; }
   std::size_t pixels() const { return std::size_t(width) * std::size_t(height); }
   std::size_t samples() const { return pixels() * std::size_t(spp()); }

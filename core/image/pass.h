@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "image/deep.h"
+#include "image/lightfield.h"
 #include "image/image.h"
 
 namespace mcr {
@@ -83,6 +84,9 @@ class Frame {
   std::vector<Pass> passes;
   std::vector<Pass> extra;  // channels with no role, carried by --keep-passes
   std::shared_ptr<const DeepSamples> deep;
+  // A light-field deep file, decoded once when read (image/lightfield.h): the flat colour and
+  // every light-field filter use this one.
+  std::shared_ptr<const LightField> lightfield;
 
   bool has(Role r) const { return find(r) != nullptr; }
   const Pass* find(Role r, Prefer p = Prefer::Feature) const;

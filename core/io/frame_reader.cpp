@@ -43,6 +43,7 @@ struct RawImage {
   std::vector<char> is_half;
   std::size_t stride = 0;
   std::shared_ptr<DeepSamples> deep;
+  std::shared_ptr<const LightField> lightfield;
 };
 
 // Native channel c of pixel px as float.
@@ -110,7 +111,8 @@ void read_deep(ImageInput& in, RawImage& raw, const std::string& path) {
     const std::size_t nc = d.channel_names.size(), np = std::size_t(raw.width) * std::size_t(raw.height);
     std::vector<float> weight;
     if (is_lightfield(d)) {
-      const LightField lf = decode_lightfield(d, path);
+      raw.lightfield = std::make_shared<const LightField>(decode_lightfield(d, path));
+      const LightField& lf = *raw.lightfield;
       weight.resize(lf.samples());
       for (std::size_t i = 0; i < weight.size(); ++i)
         weight[i] = lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[i]) *
@@ -344,6 +346,7 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
   frame.path = path;
   frame.window = raw.window;
   frame.deep = raw.deep;
+  frame.lightfield = raw.lightfield;
 
   const auto groups = group_channels(raw.names);
   for (const ChannelGroup& g : groups)

@@ -60,7 +60,7 @@ Options options_from(const ParamSet& params) {
   return o;
 }
 
-LightField lightfield_input(const Frame& frame, const std::string& filter, std::size_t* nonfinite_values) {
+std::shared_ptr<const LightField> lightfield_input(const Frame& frame, const std::string& filter) {
   if (!frame.deep)
     throw Error(Errc::MissingPass, "filter '" + filter +
                                        "' needs a light-field deep EXR (README: the light-field convention); '" +
@@ -69,12 +69,16 @@ LightField lightfield_input(const Frame& frame, const std::string& filter, std::
     throw Error(Errc::MissingPass, "filter '" + filter +
                                        "' needs a light-field deep EXR (README: the light-field convention); '" +
                                        frame.path + "' is a deep EXR without the mcrecon:lightfield attribute");
-  LightField lf = decode_lightfield(*frame.deep, frame.path, nonfinite_values);
-  if (lf.width != frame.width || lf.height != frame.height)
-    throw Error(Errc::SizeMismatch, "'" + frame.path + "': the light field is " + std::to_string(lf.width) + "x" +
-                                        std::to_string(lf.height) + ", the frame " + std::to_string(frame.width) +
-                                        "x" + std::to_string(frame.height));
-  if (lf.has_modulation()) {
+  std::shared_ptr<const LightField> decoded =
+      frame.lightfield ? frame.lightfield : std::make_shared<const LightField>(decode_lightfield(*frame.deep, frame.path));
+  if (decoded->width != frame.width || decoded->height != frame.height)
+    throw Error(Errc::SizeMismatch, "'" + frame.path + "': the light field is " + std::to_string(decoded->width) +
+                                        "x" + std::to_string(decoded->height) + ", the frame " +
+                                        std::to_string(frame.width) + "x" + std::to_string(frame.height));
+  if (!decoded->has_modulation()) return decoded;
+  auto out = std::make_shared<LightField>(*decoded);
+  LightField& lf = *out;
+  {
     const std::size_t spp = std::size_t(lf.spp());
     std::vector<float>* v[3] = {&lf.r, &lf.g, &lf.b};
     const std::vector<float>* m[3] = {&lf.mod_r, &lf.mod_g, &lf.mod_b};
@@ -84,7 +88,7 @@ LightField lightfield_input(const Frame& frame, const std::string& filter, std::
         for (std::size_t k = p * spp; k < (p + 1) * spp; ++k) (*v[c])[k] = mod > 0 ? (*v[c])[k] / mod : 0.0f;
       }
   }
-  return lf;
+  return out;
 }
 
 void remodulate(const LightField& lf, const Roi& roi, Image& out) {
@@ -99,8 +103,9 @@ void remodulate(const LightField& lf, const Roi& roi, Image& out) {
 
 std::vector<std::string> run_on_frame(const Frame& frame, const std::string& filter, const Options& o, const Roi& roi,
                                       int nthreads, Image& out, Core core, bool sheared) {
-  std::size_t nonfinite = 0;
-  const LightField lf = lightfield_input(frame, filter, &nonfinite);
+  const std::shared_ptr<const LightField> input = lightfield_input(frame, filter);
+  const LightField& lf = *input;
+  const std::size_t nonfinite = lf.nonfinite_replaced;
   Counts c;
   core(lf, o, roi, nthreads, out, &c);
   remodulate(lf, roi, out);

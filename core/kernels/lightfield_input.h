@@ -2,6 +2,7 @@
 // The light-field filters' common front: the parameters they share (one spec each, the same
 // name, range and help in every table) and the decoded light field of a frame.
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -29,7 +30,9 @@ Options options_from(const ParamSet& params);
 // convention), Error(SizeMismatch) when it is not the frame's size; decode's errors pass through.
 // With a modulation (image/lightfield.h), the samples come back divided by their pixel's mod
 // (0 where the mod is 0): what the filters shear; remodulate() multiplies the result back.
-LightField lightfield_input(const Frame& frame, const std::string& filter, std::size_t* nonfinite_values);
+// The frame's decoded light field is used as it is (read_frame decodes it once); a frame built
+// in memory with only the deep buffer is decoded here.
+std::shared_ptr<const LightField> lightfield_input(const Frame& frame, const std::string& filter);
 void remodulate(const LightField& lf, const Roi& roi, Image& out);
 
 // What each light-field filter's run() does around its core: decode (and demodulate) the

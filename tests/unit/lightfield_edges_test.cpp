@@ -157,7 +157,7 @@ TEST(LightFieldEdges, TheModulationKeepsTheShadingOutOfTheShear) {
     Frame frame;
     frame.width = in.width, frame.height = in.height, frame.path = "edge.exr";
     frame.deep = std::make_shared<DeepSamples>(encode_lightfield(in));
-    const LightField dec = lf::lightfield_input(frame, "sheared", nullptr);
+    const LightField dec = *lf::lightfield_input(frame, "sheared");
     Image out(in.width, in.height, 3);
     lf::Options o;
     sheared_lightfield(dec, o, Roi::all(in.width, in.height), 0, out, nullptr);
