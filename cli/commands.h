@@ -27,5 +27,6 @@ Run add_demo(CLI::App& app);
 Run add_sparsify(CLI::App& app);
 Run add_plan(CLI::App& app);
 Run add_lightfield(CLI::App& app);
+Run add_report(CLI::App& app);
 
 }  // namespace mcr::cli

@@ -59,6 +59,8 @@ int main(int argc, char** argv) {
       mcr::cli::add_sparsify);
   add("lightfield", "render light-field samples (soft shadows, depth of field, indirect light) for the sheared filters",
       mcr::cli::add_lightfield);
+  add("report", "run time against error: every filter, auto, parameter sweeps and peers on the sample scenes or "
+      "your renders, as report.html + results.json/csv", mcr::cli::add_report);
   add("demo", "run every filter on the sample scenes: table + side-by-side PNGs", mcr::cli::add_demo);
 
   try {

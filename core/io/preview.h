@@ -17,4 +17,9 @@ struct DisplayOptions : DisplayTransform {
 void write_side_by_side_png(const std::string& path, const std::vector<const Image*>& tiles,
                             const DisplayOptions& options = {});
 
+// One image's region (the whole image when `region` is empty), enlarged `zoom` times by
+// repeating pixels (so that single pixels stay visible), as an 8-bit PNG via temp + rename.
+void write_display_png(const std::string& path, const Image& image, const Roi& region = {}, int zoom = 1,
+                       const DisplayTransform& transform = {});
+
 }  // namespace mcr

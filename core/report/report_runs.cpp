@@ -1,0 +1,229 @@
+#include "report/report_runs.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "io/frame_reader.h"
+#include "io/sequence.h"
+#include "pipeline/auto_filter.h"
+#include "util/error.h"
+#include "util/memory_usage.h"
+
+namespace mcr {
+
+namespace fs = std::filesystem;
+
+LoadedReportScene load_report_scene(const ReportScene& scene) {
+  LoadedReportScene s;
+  s.scene = scene;
+  for (std::size_t i = 0; i < scene.frames.size(); ++i) {
+    s.flat.push_back(read_frame(scene.noisy[i]));
+    s.flat.back().frame_number = scene.frames[i];
+    if (!scene.deep[i].empty()) {
+      if (scene.deep[i] == scene.noisy[i]) {
+        if (s.flat.back().deep) s.deep.push_back(s.flat.back());
+      } else {
+        s.deep.push_back(read_frame(scene.deep[i]));
+        s.deep.back().frame_number = scene.frames[i];
+      }
+    }
+    Frame ref = read_frame(scene.reference[i]);
+    const Image& rgb = ref.image(Role::Colour);
+    if (rgb.width() != s.flat.back().width || rgb.height() != s.flat.back().height)
+      throw Error(Errc::SizeMismatch, "reference '" + scene.reference[i] + "' is " + std::to_string(rgb.width()) + "x" +
+                                          std::to_string(rgb.height()) + ", the render '" + scene.noisy[i] + "' " +
+                                          std::to_string(s.flat.back().width) + "x" +
+                                          std::to_string(s.flat.back().height));
+    s.references.push_back(rgb);
+  }
+  if (s.deep.size() != s.flat.size()) s.deep.clear();  // deep filters need every frame
+  if (s.scene.kind.empty()) {
+    const Frame& f = s.flat.front();
+    s.scene.kind = f.lightfield ? "lightfield" : f.deep ? "deep" : s.flat.size() > 1 ? "sequence" : "still";
+  }
+  return s;
+}
+
+Scores score_outputs(const std::vector<Image>& outputs, const std::vector<Image>& references, int nthreads) {
+  Scores sc;
+  const double n = double(outputs.size());
+  double temporal = 0;
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const ImageMetrics m = compare_images(references[i], outputs[i], nthreads);
+    sc.mean.rmse += m.rmse / n;
+    sc.mean.relmse += m.relmse / n;
+    sc.mean.psnr += m.psnr / n;
+    sc.mean.ssim += m.ssim / n;
+    sc.frame_relmse.push_back(m.relmse);
+    sc.frame_temporal.push_back(i ? temporal_error(outputs[i - 1], outputs[i], nthreads) : -1.0);
+    if (i) temporal += sc.frame_temporal.back();
+  }
+  if (outputs.size() > 1) sc.temporal_error = temporal / (n - 1);
+  return sc;
+}
+
+const std::vector<Frame>* frames_for(const LoadedReportScene& s, Filter& filter, std::string& why) {
+  const FilterInfo& info = filter.info();
+  const std::vector<Frame>* frames = &s.flat;
+  if (info.deep_input) {
+    const bool lightfield = !s.deep.empty() && s.deep.front().lightfield;
+    if (s.deep.empty() || lightfield != info.lightfield_input) {
+      why = info.lightfield_input ? "needs a light-field deep EXR" : "needs per-sample (deep) input";
+      return nullptr;
+    }
+    frames = &s.deep;
+  }
+  const std::vector<Role> missing = filter.missing_passes(frames->front());
+  if (!missing.empty()) {
+    why = "missing passes:";
+    for (Role m : missing) why += std::string(" ") + role_name(m);
+    return nullptr;
+  }
+  return frames;
+}
+
+RunResult run_in_process(const LoadedReportScene& s, Filter& filter, const std::vector<Frame>& frames, int nthreads) {
+  RunResult r;
+  r.filter = filter.info().name;
+  ExecOptions exec;
+  exec.nthreads = nthreads;
+  filter.reset();
+  const bool peak = reset_peak_resident();
+  const double before = resident_mb();
+  double seconds = 0;
+  for (const Frame& f : frames) {
+    const auto t0 = std::chrono::steady_clock::now();
+    r.outputs.push_back(filter.execute(f, exec));
+    seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+  // The outputs are kept for scoring: subtract them, they are not the filter's working memory.
+  double kept = 0;
+  for (const Image& o : r.outputs) kept += double(o.storage().size() * sizeof(float)) / (1024.0 * 1024.0);
+  if (peak) r.peak_memory_mb = std::max(0.0, peak_resident_mb() - before - kept);
+  r.seconds = r.filter_seconds = seconds;
+  r.scores = score_outputs(r.outputs, s.references, nthreads);
+  for (const std::string& n : filter.notes()) r.notes.push_back(n);
+  if (const auto* a = dynamic_cast<const AutoFilter*>(&filter)) {
+    r.kind = "auto";
+    r.chosen = a->chosen();
+  }
+  return r;
+}
+
+namespace {
+
+// "mcrecon: ...: read 28.9 ms, filter 13.0 ms, write ..." (the last such line: all frames).
+double parse_filter_ms(const std::string& log) {
+  static const std::regex re("filter ([0-9.]+) ms");
+  double ms = -1;
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    std::smatch m;
+    if (line.rfind("mcrecon:", 0) == 0 && std::regex_search(line, m, re)) ms = std::stod(m[1]);
+  }
+  return ms;
+}
+
+std::string read_all(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+void fail(RunResult& r, const std::string& what, const CommandRun& run, const std::string& log) {
+  r.error = what + (run.timed_out ? ": timed out" : ": exit " + std::to_string(run.exit_code)) + "; " + log_tail(log);
+}
+
+std::vector<Image> read_outputs(const std::vector<std::string>& files, const LoadedReportScene& s, RunResult& r) {
+  std::vector<Image> out;
+  for (std::size_t i = 0; i < files.size(); ++i) {
+    try {
+      Image img = read_pass_file(files[i], Role::Colour).image;
+      if (img.width() != s.references[i].width() || img.height() != s.references[i].height() || img.channels() < 3)
+        throw Error(Errc::SizeMismatch, "'" + files[i] + "' is " + std::to_string(img.width()) + "x" +
+                                            std::to_string(img.height()) + " with " + std::to_string(img.channels()) +
+                                            " channels, the render " + std::to_string(s.references[i].width()) + "x" +
+                                            std::to_string(s.references[i].height()) + " RGB");
+      out.push_back(std::move(img));
+    } catch (const Error& e) {
+      r.error = std::string("its output: ") + e.what();
+      return {};
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+RunResult run_as_command(const LoadedReportScene& s, const std::string& filter, const std::string& set,
+                         bool deep_input, const CommandTiming& timing) {
+  RunResult r;
+  r.filter = filter;
+  const ReportScene& sc = s.scene;
+  const bool sequence = !sc.frames_text.empty();
+  const std::string tag = filter + (set.empty() ? "" : "_" + std::to_string(std::hash<std::string>{}(set) % 100000));
+  const std::string out = (fs::path(timing.work_dir) / (sc.id + "_" + tag + (sequence ? "_####.exr" : ".exr"))).string();
+  std::vector<std::string> argv = {timing.cli, "denoise", "-f", filter, "--timings", "-j", std::to_string(timing.nthreads)};
+  if (!set.empty()) argv.insert(argv.end(), {"--set", set});
+  if (sequence) argv.insert(argv.end(), {"--frames", sc.frames_text});
+  argv.push_back(sequence ? (deep_input ? sc.deep_pattern : sc.noisy_pattern) : (deep_input ? sc.deep[0] : sc.noisy[0]));
+  argv.insert(argv.end(), {"-o", out});
+  const std::string log = out.substr(0, out.size() - 4) + ".log";
+  const CommandRun run = run_timed_command(argv, log, timing.timeout_seconds);
+  if (run.exit_code != 0 || run.timed_out) {
+    fail(r, "mcrecon denoise -f " + filter, run, log);
+    return r;
+  }
+  r.seconds = run.seconds;
+  r.peak_memory_mb = run.peak_memory_mb;
+  const double ms = parse_filter_ms(read_all(log));
+  r.filter_seconds = ms >= 0 ? ms / 1000.0 : -1;
+  std::vector<std::string> files;
+  for (int f : sc.frames) files.push_back(sequence ? sequence_path(out, f) : out);
+  r.outputs = read_outputs(files, s, r);
+  if (r.ok()) r.scores = score_outputs(r.outputs, s.references, timing.nthreads);
+  return r;
+}
+
+RunResult run_peer(const LoadedReportScene& s, const PeerCommand& peer, const CommandTiming& timing) {
+  RunResult r;
+  r.filter = peer.name;
+  r.kind = "peer";
+  r.id = "peer_" + peer.name;
+  r.seconds = 0;
+  std::vector<std::string> files;
+  for (std::size_t i = 0; i < s.flat.size(); ++i) {
+    const fs::path dir = fs::path(timing.work_dir) / (s.scene.id + "_peer_" + peer.name + "_" + std::to_string(i));
+    fs::create_directories(dir);
+    std::string output;
+    std::vector<std::string> argv;
+    try {
+      argv = peer_argv(peer, s.flat[i], dir.string(), output);
+    } catch (const Error& e) {
+      r.error = e.what();
+      return r;
+    }
+    const std::string log = (dir / "peer.log").string();
+    const CommandRun run = run_timed_command(argv, log, timing.timeout_seconds);
+    if (run.exit_code != 0 || run.timed_out) {
+      fail(r, "peer '" + peer.name + "' on '" + s.scene.noisy[i] + "'", run, log);
+      return r;
+    }
+    if (!fs::is_regular_file(output)) {
+      r.error = "peer '" + peer.name + "' exited 0 but wrote no '" + output + "'; " + log_tail(log);
+      return r;
+    }
+    r.seconds += run.seconds;
+    r.peak_memory_mb = std::max(r.peak_memory_mb, run.peak_memory_mb);
+    files.push_back(output);
+  }
+  r.outputs = read_outputs(files, s, r);
+  if (r.ok()) r.scores = score_outputs(r.outputs, s.references, timing.nthreads);
+  return r;
+}
+
+}  // namespace mcr
