@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "report_binding.h"
 #include "io/deep_writer.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
@@ -716,4 +717,6 @@ PYBIND11_MODULE(mcrecon, m) {
       "The passes a filter needs with these settings (and accumulate): {'required': [role, ...], "
       "'optional': [role, ...], 'why': {role: the setting that requires it}}; parameter errors raise "
       "mcrecon.Error as Session does.");
+
+  add_report_binding(m);
 }

@@ -69,6 +69,7 @@ std::vector<ReportScene> per_sample_scenes(const fs::path& dir) {
     r.noisy = {deep};  // the image-space filters get its flattened passes
     r.deep = {deep};
     r.reference = {(dir / s.at("reference").get<std::string>()).string()};
+    if (r.spp > 0) r.levels = {{r.spp, {deep}}};
     out.push_back(r);
   }
   return out;
