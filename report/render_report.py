@@ -23,11 +23,11 @@ import matplotlib
 
 matplotlib.use("Agg")  # no display, no GUI toolkit
 matplotlib.rcParams["text.usetex"] = False
-matplotlib.rcParams["text.parse_math"] = False  # filter names and parameters are shown as typed
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.colors import LogNorm  # noqa: E402
 from matplotlib.lines import Line2D  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
+from matplotlib.ticker import MaxNLocator  # noqa: E402
 
 FORMAT = "mcrecon-report-1"
 SPLIT_TEXT = {"tune": "settings chosen on this scene", "report": "held out", "user": "user render"}
@@ -175,6 +175,11 @@ def read_error_map(path):
 
 # ---------------------------------------------------------------- plots
 
+def mt(s):
+    """Text for matplotlib as typed: a '$' in a name would start mathtext."""
+    return str(s).replace("$", r"\$")
+
+
 def run_label(r):
     if r.get("kind") == "auto":
         return "auto -> %s" % r["chosen"] if r.get("chosen") else "auto"
@@ -201,6 +206,7 @@ def place_labels(ax, items, fontsize=7):
     offsets = [(5, 4), (5, -11), (-5, 4), (-5, -11), (5, 14), (5, -21), (-5, 14), (-5, -21),
                (12, 24), (12, -31)]
     h = fontsize * 1.3 * fig.dpi / 72.0
+    ax_box = ax.get_window_extent()
     for x, y, text in items:
         px, py = to_px.transform((x, y))
         w = len(text) * fontsize * 0.6 * fig.dpi / 72.0
@@ -209,11 +215,13 @@ def place_labels(ax, items, fontsize=7):
             ox, oy = dx * fig.dpi / 72.0, dy * fig.dpi / 72.0
             x0 = px + ox if dx >= 0 else px + ox - w
             box = (x0, py + oy, x0 + w, py + oy + h)
-            if not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
+            inside = ax_box.x0 <= box[0] and box[2] <= ax_box.x1 and ax_box.y0 <= box[1] and box[3] <= ax_box.y1
+            if inside and not any(box[0] < b[2] and b[0] < box[2] and box[1] < b[3] and b[1] < box[3] for b in placed):
                 best = (dx, dy)
                 placed.append(box)
                 break
         else:
+            best = (-5, 4) if px + w > ax_box.x1 else (5, 4)
             placed.append((px, py, px + w, py + h))
         ax.annotate(text, (x, y), xytext=best, textcoords="offset points", fontsize=fontsize,
                     ha="left" if best[0] >= 0 else "right", va="bottom", color="0.15")
@@ -245,7 +253,7 @@ def pareto_plot(scene, key, path):
         c = colours.get(f, "0.5")
         ax.plot([r["seconds"] for r in rs], [r[key] for r in rs], "-", lw=0.7, color=c, zorder=2)
         ax.scatter([r["seconds"] for r in rs], [r[key] for r in rs], s=28, facecolors="white",
-                   edgecolors=[c], linewidths=1.1, zorder=3, label="%s: sweep of %s" % (f, param))
+                   edgecolors=[c], linewidths=1.1, zorder=3, label=mt("%s: sweep of %s" % (f, param)))
     marker = {"filter": "o", "auto": "*", "peer": "D"}
     size = {"filter": 40, "auto": 150, "peer": 45}
     labels = []
@@ -259,7 +267,7 @@ def pareto_plot(scene, key, path):
                    facecolors=[c] if filled else "white", edgecolors="black" if filled else [c],
                    linewidths=0.6, zorder=4)
         if filled:
-            labels.append((r["seconds"], r[key], run_label(r)))
+            labels.append((r["seconds"], r[key], mt(run_label(r))))
     front = sorted((r for r in shown if r.get("pareto_" + key)), key=lambda r: r["seconds"])
     if front:
         ax.step([r["seconds"] for r in front], [r[key] for r in front], where="post", color="0.2",
@@ -268,7 +276,7 @@ def pareto_plot(scene, key, path):
         v = lv.get(key)
         if is_num(v) and (v > 0 or not log_y):
             ax.axhline(v, ls="--", lw=0.8, color="0.45", zorder=0)
-            ax.annotate(str(lv.get("label", "")), (0.005, v), xycoords=("axes fraction", "data"),
+            ax.annotate(mt(lv.get("label", "")), (0.005, v), xycoords=("axes fraction", "data"),
                         xytext=(2, 2), textcoords="offset points", fontsize=7, color="0.3")
     ax.set_xscale("log")
     if log_y:
@@ -276,9 +284,9 @@ def pareto_plot(scene, key, path):
     ax.set_xlabel("run time, seconds (log)")
     ax.set_ylabel("relMSE (log, lower is better)" if log_y else "SSIM (higher is better)")
     ax.grid(True, which="major", lw=0.4, alpha=0.5)
-    ax.set_title("%s: %s against time\n%s" % (scene.get("id"), "relMSE" if log_y else "SSIM",
+    ax.set_title(mt("%s: %s against time\n%s" % (scene.get("id"), "relMSE" if log_y else "SSIM",
                                                TIMING_TEXT.get(scene.get("timing"), "time: %s" % scene.get("timing"))),
-                 fontsize=10)
+                 ), fontsize=10)
     place_labels(ax, labels)
     handles = [
         Line2D([], [], ls="", marker="o", mfc="0.6", mec="black", label="filter, default settings"),
@@ -291,7 +299,7 @@ def pareto_plot(scene, key, path):
     h2, l2 = ax.get_legend_handles_labels()
     ax.legend(handles=handles + h2, fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
     if left_out:
-        ax.text(0.99, 0.01, "not drawn (no value or not positive): " + ", ".join(map(str, left_out)),
+        ax.text(0.99, 0.01, mt("not drawn (no value or not positive): " + ", ".join(map(str, left_out))),
                 transform=ax.transAxes, ha="right", va="bottom", fontsize=6, color="0.4")
     save_fig(fig, path)
     return left_out
@@ -322,7 +330,7 @@ def error_maps_plot(scene, out_dir, path):
     h, w = maps[0][2].shape
     pw = 3.2
     fig, axes = plt.subplots(rows, cols, figsize=(pw * cols + 1.0, pw * h / max(w, 1) * rows + 0.8),
-                             squeeze=False)
+                             squeeze=False, layout="constrained")
     cmap = plt.get_cmap("inferno").copy()
     cmap.set_bad("cyan")  # non-finite pixels stand out
     im = None
@@ -333,10 +341,10 @@ def error_maps_plot(scene, out_dir, path):
         name, relmse, m = maps[i]
         shown = np.where(np.isfinite(m), np.clip(m, vmin, vmax), np.nan)  # zeros clip to the bottom
         im = ax.imshow(shown, cmap=cmap, norm=LogNorm(vmin=vmin, vmax=vmax), interpolation="nearest")
-        ax.set_title("%s (relMSE %s)" % (name, fmt(relmse)), fontsize=8)
+        ax.set_title(mt("%s (relMSE %s)" % (name, fmt(relmse))), fontsize=8)
     cb = fig.colorbar(im, ax=axes.ravel().tolist(), shrink=0.9)
     cb.set_label("relative squared error per pixel (log)", fontsize=8)
-    fig.suptitle("%s: error maps, one scale" % scene.get("id"), fontsize=10)
+    fig.suptitle(mt("%s: error maps, one log scale" % scene.get("id")), fontsize=10)
     save_fig(fig, path)
     return len(maps)
 
@@ -359,20 +367,21 @@ def per_frame_plot(scene, key, path):
         x, y = series(r["per_frame"])
         if x:
             ax.plot(x, y, marker={"auto": "*", "peer": "D"}.get(r.get("kind"), "o"), ms=4, lw=1,
-                    color=colours.get(r.get("filter") or r.get("id")), label=run_label(r))
+                    color=colours.get(r.get("filter") or r.get("id")), label=mt(run_label(r)))
             drawn += 1
     for lv in scene.get("levels") or []:
         if lv.get("per_frame"):
             x, y = series(lv["per_frame"])
             if x:
-                ax.plot(x, y, "--", lw=0.8, color="0.45", label=str(lv.get("label")))
+                ax.plot(x, y, "--", lw=0.8, color="0.45", label=mt(lv.get("label")))
                 drawn += 1
     if key == "relmse":
         ax.set_yscale("log")
     ax.set_xlabel("frame")
+    ax.xaxis.set_major_locator(MaxNLocator(integer=True))
     ax.set_ylabel({"relmse": "relMSE (log)", "temporal_error": "temporal error"}[key])
-    ax.set_title("%s: %s per frame (lower is better)" % (
-        scene.get("id"), {"relmse": "relMSE", "temporal_error": "temporal error"}[key]), fontsize=10)
+    ax.set_title(mt("%s: %s per frame (lower is better)" % (
+        scene.get("id"), {"relmse": "relMSE", "temporal_error": "temporal error"}[key])), fontsize=10)
     ax.grid(True, lw=0.4, alpha=0.5)
     if drawn:
         ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))
@@ -429,12 +438,12 @@ def scaling_plots(scaling, plots_dir):
                     lab += " (slope %s)" % fmt(fit["slope"])
                 elif key == "peak_memory_mb" and is_num(fit.get("peak_memory_mb_per_megapixel")):
                     lab += " (%s MB/MP)" % fmt(fit["peak_memory_mb_per_megapixel"])
-                ax.plot([p for p, _ in pts], [v for _, v in pts], marker="o", ms=3, lw=1, label=lab)
+                ax.plot([p for p, _ in pts], [v for _, v in pts], marker="o", ms=3, lw=1, label=mt(lab))
             ax.set_xscale("log")
             ax.set_yscale("log")
             ax.set_xlabel("pixels (log)")
             ax.set_ylabel(ylabel)
-            ax.set_title("%s input" % inp, fontsize=10)
+            ax.set_title(mt("%s input" % inp), fontsize=10)
             ax.grid(True, which="both", lw=0.3, alpha=0.5)
             if lines:
                 ax.legend(fontsize=7, loc="upper left")
@@ -457,8 +466,8 @@ td.num{text-align:right;font-variant-numeric:tabular-nums}
 .meta{color:#555;font-size:.9em}.plot{max-width:100%;height:auto;display:block;margin:.5em 0}
 .tiles{display:flex;flex-wrap:wrap;gap:.5em;align-items:flex-start;margin:.4em 0}
 .tile{text-align:center;font-size:.75em;max-width:200px}.tile img{display:block;margin:0 auto;border:1px solid #999}
-img.px{image-rendering:pixelated;width:128px;height:128px}img.thumb{width:200px;height:auto}
-.missing{width:128px;height:128px;border:1px dashed #c00;color:#c00;font-size:.7em;display:flex;align-items:center}
+img.px{image-rendering:pixelated}.tile{min-width:90px}img.thumb{width:200px;height:auto}
+.missing{width:64px;height:64px;border:1px dashed #c00;color:#c00;font-size:.7em;display:flex;align-items:center}
 .note{background:#f7f7f7;border-left:3px solid #999;padding:.5em 1em;font-size:.9em}
 nav ul{columns:3;font-size:.9em}
 """
@@ -499,7 +508,7 @@ def levels_table(scene):
     cols = [c for c in LEVEL_COLUMNS if seq or c[0] != "temporal_error"]
     out = ['<table class="levels"><tr><th>render</th>'] + ["<th>%s</th>" % esc(h) for _, h in cols] + ["</tr>"]
     for i, lv in enumerate(scene.get("levels") or []):
-        out.append("<tr><td>%s%s</td>" % (esc(lv.get("label")), " (the input)" if lv.get("is_input") else ""))
+        out.append("<tr><td>%s</td>" % esc(lv.get("label")))
         for k, _ in cols:
             out.append(num_cell(lv.get(k), [("data-scene", scene.get("id")), ("data-level", i), ("data-key", k)]))
         out.append("</tr>")
@@ -679,7 +688,7 @@ def render(out_dir):
         "run's relMSE (by a power-law fit through the renders' relMSE against spp), over the input's "
         "sample count; 3.2x means the filter did what 3.2 times the samples would. Table numbers are "
         "rounded to 4 significant digits; the exact values are in results.json.</div>",
-        '<div id="report-status" data-errors="-1" data-images="-1" data-broken="-1">page check did not run</div>',
+        '<div id="report-status" class="meta" data-errors="-1" data-images="-1" data-broken="-1">page check did not run</div>',
     ]
     page = "\n".join(head + toc + body + [TAIL_SCRIPT, "</body></html>"])
     path = os.path.join(out_dir, "report.html")
