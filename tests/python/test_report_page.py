@@ -267,11 +267,21 @@ class ReportPageTest(unittest.TestCase):
             with open(os.path.join(plots, n), "rb") as f:
                 data = f.read()
             self.assertEqual(data[:8], b"\x89PNG\r\n\x1a\n", n)
-            self.assertIn("data:image/png;base64," + base64.b64encode(data).decode(), embedded, n)
-        # Self-contained: every image a decodable PNG data URI; no file, network or stylesheet link.
-        for src in self.parsed.imgs:
+            self.assertTrue("data:image/png;base64," + base64.b64encode(data).decode() in embedded,
+                            "plots/%s is not embedded in the page" % n)
+        # Self-contained: every image a PNG data URI that decodes whole (a browser shows a truncated
+        # PNG without an error); no file, network or stylesheet link.
+        probe = os.path.join(self.tmp, "probe.png")
+        for src in embedded:
             self.assertTrue(src.startswith("data:image/png;base64,"), src[:80])
-            self.assertEqual(base64.b64decode(src.split(",", 1)[1])[:4], b"\x89PNG")
+            with open(probe, "wb") as f:
+                f.write(base64.b64decode(src.split(",", 1)[1]))
+            inp = oiio.ImageInput.open(probe)
+            self.assertIsNotNone(inp, oiio.geterror())
+            px = inp.read_image(oiio.FLOAT)
+            err = inp.geterror()
+            inp.close()
+            self.assertIsNotNone(px, "an embedded PNG does not decode: %s" % err)
         for link in self.parsed.links:
             self.assertTrue(link.startswith("#"), link)
         self.assertNotIn("http://", self.text.replace("http://www.w3.org", ""))
