@@ -536,7 +536,8 @@ def crops_html(scene, images, locator):
             locator, "crop regions", "plot"))
     for i, c in enumerate(crops):
         z = c.get("zoom") or {}
-        out.append('<p class="meta">crop %d: x %s, y %s, %s&times;%s pixels; 4:1 zoom of x %s, y %s, %s&times;%s</p>' % (
+        out.append('<p class="meta">crop %d: x %s, y %s, %s&times;%s pixels; '
+                   '4:1 zoom of x %s, y %s, %s&times;%s</p>' % (
             i, c.get("x"), c.get("y"), c.get("w"), c.get("h"), z.get("x"), z.get("y"), z.get("w"), z.get("h")))
         for scale, key in (("1:1", "1x"), ("4:1", "4x")):
             row = [tile(images, c.get("noisy_" + key), noisy_lab, "px")]
@@ -688,7 +689,8 @@ def render(out_dir):
         "run's relMSE (by a power-law fit through the renders' relMSE against spp), over the input's "
         "sample count; 3.2x means the filter did what 3.2 times the samples would. Table numbers are "
         "rounded to 4 significant digits; the exact values are in results.json.</div>",
-        '<div id="report-status" class="meta" data-errors="-1" data-images="-1" data-broken="-1">page check did not run</div>',
+        '<div id="report-status" class="meta" data-errors="-1" data-images="-1" data-broken="-1">'
+        "page check did not run</div>",
     ]
     page = "\n".join(head + toc + body + [TAIL_SCRIPT, "</body></html>"])
     path = os.path.join(out_dir, "report.html")
