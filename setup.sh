@@ -22,6 +22,7 @@ PACKAGES=(
   blender xvfb xauth
   clang libclang-rt-14-dev libfuzzer-14-dev llvm-14
   slurm-wlm munge  # py_test_farm_slurm starts a one-node Slurm cluster
+  python3-matplotlib python3-opencv chromium  # mcrecon report: plots, the OpenCV peer, the page test (issue 20)
 )
 
 missing=()
