@@ -92,7 +92,25 @@ std::vector<std::string> split_words(const std::string& text, const std::string&
   return words;
 }
 
+// PFM (OpenImageIO 2.4 reads it but cannot write it): "PF", size, a negative scale for
+// little-endian floats, then RGB rows from the bottom up.
+void write_pfm(const Image& img, const std::string& path) {
+  std::string data = "PF\n" + std::to_string(img.width()) + " " + std::to_string(img.height()) + "\n-1.0\n";
+  const std::size_t header = data.size();
+  data.resize(header + std::size_t(img.width()) * std::size_t(img.height()) * 3 * sizeof(float));
+  char* dst = data.data() + header;
+  for (int y = img.height() - 1; y >= 0; --y)
+    for (int x = 0; x < img.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float v = img.at(x, y, img.channels() >= 3 ? c : 0);  // one channel: grey RGB
+        std::memcpy(dst, &v, sizeof v);
+        dst += sizeof v;
+      }
+  write_text_atomic(data, path);
+}
+
 void write_pass(const Image& img, int channels, const std::string& path, const std::string& format) {
+  if (format == "pfm") return write_pfm(img, path);
   OIIO::ImageBuf buf(OIIO::ImageSpec(img.width(), img.height(), channels, OIIO::TypeFloat));
   const Image part = img.channels() == channels ? img : img.channel_range(0, std::min(channels, img.channels()));
   if (part.channels() == channels) {

@@ -24,6 +24,7 @@
 #include "io/sample_manifest.h"
 #include "pipeline/filter_catalog.h"
 #include "report/parameter_sweeps.h"
+#include "report/report_math.h"
 #include "report/report_images.h"
 #include "report/report_runs.h"
 #include "report/scaling.h"
@@ -115,37 +116,19 @@ json per_frame_json(const ReportScene& sc, const Scores& s) {
   return {{"frame", sc.frames}, {"relmse", r}, {"temporal_error", t}};
 }
 
-// The spp at which the noisy render reaches `relmse`, over the input's spp: relMSE is taken
-// as a power of spp between the scene's levels (log-log linear, the nearest two beyond them;
-// with one level, relMSE ~ 1/spp as for an unbiased estimator).
-double worth_x_samples(const std::vector<std::pair<int, double>>& levels, int input_spp, double relmse) {
-  if (levels.empty() || input_spp <= 0 || !(relmse > 0)) return -1;
-  const double y = std::log(relmse);
-  if (levels.size() == 1) return levels[0].second / relmse * levels[0].first / input_spp;
-  std::size_t i = 0;
-  while (i + 2 < levels.size() && std::log(levels[i + 1].second) > y) ++i;
-  const double x0 = std::log(double(levels[i].first)), x1 = std::log(double(levels[i + 1].first));
-  const double y0 = std::log(levels[i].second), y1 = std::log(levels[i + 1].second);
-  if (!(y1 < y0)) return -1;  // the levels do not fall with spp: no honest extrapolation
-  return std::exp(x0 + (y - y0) * (x1 - x0) / (y1 - y0)) / input_spp;
-}
-
 void mark_pareto(std::vector<RunResult>& runs) {
-  for (RunResult& a : runs) {
-    if (!a.ok()) continue;
-    bool rel = true, ss = true;
-    for (const RunResult& b : runs) {
-      if (&a == &b || !b.ok()) continue;
-      const bool faster_eq = b.seconds <= a.seconds;
-      if (faster_eq && b.scores.mean.relmse <= a.scores.mean.relmse &&
-          (b.seconds < a.seconds || b.scores.mean.relmse < a.scores.mean.relmse))
-        rel = false;
-      if (faster_eq && b.scores.mean.ssim >= a.scores.mean.ssim &&
-          (b.seconds < a.seconds || b.scores.mean.ssim > a.scores.mean.ssim))
-        ss = false;
+  std::vector<std::size_t> ok;
+  std::vector<std::pair<double, double>> rel, ssim;
+  for (std::size_t i = 0; i < runs.size(); ++i)
+    if (runs[i].ok()) {
+      ok.push_back(i);
+      rel.push_back({runs[i].seconds, runs[i].scores.mean.relmse});
+      ssim.push_back({runs[i].seconds, runs[i].scores.mean.ssim});
     }
-    a.pareto_relmse = rel;
-    a.pareto_ssim = ss;
+  const std::vector<bool> fr = pareto_front(rel, true), fs = pareto_front(ssim, false);
+  for (std::size_t k = 0; k < ok.size(); ++k) {
+    runs[ok[k]].pareto_relmse = fr[k];
+    runs[ok[k]].pareto_ssim = fs[k];
   }
 }
 
