@@ -451,7 +451,45 @@ def scaling_plots(scaling, plots_dir):
             "run time" if key == "seconds" else "peak memory", scaling.get("threads", "?")), fontsize=10)
         save_fig(fig, os.path.join(plots_dir, name))
         out.append(name)
+    spp = spp_plot(scaling, plots_dir)
+    if spp:
+        out.append(spp)
     return out
+
+
+def spp_plot(scaling, plots_dir):
+    """Run time against samples per pixel (one scene per input kind at its rendered spp levels)."""
+    rows = [r for r in scaling.get("spp_rows") or [] if is_num(r.get("spp")) and is_num(r.get("seconds"))
+            and r["seconds"] > 0]
+    if not rows:
+        return None
+    inputs = []
+    for r in rows:
+        if r.get("input") not in inputs:
+            inputs.append(r.get("input"))
+    fig, axes = plt.subplots(1, len(inputs), figsize=(5.5 * len(inputs) + 1.5, 4.5), squeeze=False)
+    for ax, inp in zip(axes[0], inputs):
+        lines = {}
+        for r in rows:
+            if r.get("input") == inp:
+                lines.setdefault(r.get("filter"), []).append((r["spp"], r["seconds"]))
+        for f, pts in lines.items():
+            pts.sort()
+            ax.plot([p for p, _ in pts], [v for _, v in pts], marker="o", ms=3, lw=1, label=mt(str(f)))
+        sizes = {(r.get("width"), r.get("height")) for r in rows if r.get("input") == inp}
+        scene = {r.get("scene") for r in rows if r.get("input") == inp}
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("samples per pixel (log)")
+        ax.set_ylabel("seconds (log)")
+        ax.set_title(mt("%s input: %s, %s" % (inp, ", ".join(sorted(map(str, scene))),
+                                              ", ".join("%sx%s" % s for s in sorted(sizes)))), fontsize=10)
+        ax.grid(True, which="both", lw=0.3, alpha=0.5)
+        ax.legend(fontsize=7, loc="upper left")
+    fig.suptitle("run time against samples per pixel (%s threads)" % scaling.get("threads", "?"), fontsize=10)
+    name = "scaling_spp.png"
+    save_fig(fig, os.path.join(plots_dir, name))
+    return name
 
 
 # ---------------------------------------------------------------- page
@@ -594,8 +632,9 @@ def scene_html(scene, idx, n, out_dir, plots_dir, images):
 
 def scaling_html(scaling, plots_dir, images):
     out = ['<section id="scaling"><h2>Scaling</h2>']
-    if scaling.get("method"):
-        out.append('<p class="meta">%s</p>' % esc(scaling["method"]))
+    for key in ("method", "spp_method"):
+        if scaling.get(key):
+            out.append('<p class="meta">%s</p>' % esc(scaling[key]))
     names = scaling_plots(scaling, plots_dir)
     if not names:
         out.append("<p>No scaling measurements.</p>")

@@ -393,6 +393,24 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
       }
     }
   }
+  // Time against spp: the first scene of each kind rendered at several spp (flat stills at
+  // 1-64, the light field at 4-16; the per-sample scenes have one), each level tiled to one size.
+  std::map<std::string, std::vector<std::pair<int, Frame>>> by_spp;
+  std::map<std::string, std::string> spp_names;
+  for (const ReportScene& sc : scenes) {
+    if (sc.levels.size() < 2) continue;
+    const bool lf = sc.kind == "lightfield";
+    const std::string k = lf ? "lightfield" : sc.kind == "deep" ? "deep" : "flat";
+    if (by_spp.count(k)) continue;
+    for (const ReportLevel& l : sc.levels) {
+      const std::string& path = lf ? (l.deep.empty() ? std::string() : l.deep[0]) : l.paths[l.paths.size() / 2];
+      if (path.empty()) continue;
+      by_spp[k].push_back({l.spp, read_frame(path)});
+    }
+    spp_names[k] = sc.scene;
+  }
+  const int spp_side = std::min(512, std::max(c.o.scaling_min, c.o.scaling_max));
+  json spp_rows = json::array();
   json src_json = json::object();
   for (const auto& [k, v] : source_names) src_json[k] = v;
   for (const std::string& name : c.filters) {
@@ -412,6 +430,16 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
                        std::to_string(r.width), std::to_string(r.height), value_text(double(r.width) * r.height),
                        "in-process"});
     }
+    for (const auto& [spp, frame] : by_spp[kind]) {
+      if (!f->missing_passes(frame).empty()) continue;
+      const ScalingRow r =
+          measure_scaling(*f, frame, kind, {spp_side}, c.threads, c.o.repeat, [&](const std::string& l) {
+            c.log(l + " (" + std::to_string(spp) + " spp)");
+          }).front();
+      spp_rows.push_back({{"filter", r.filter}, {"input", kind}, {"scene", spp_names[kind]}, {"spp", spp},
+                          {"width", r.width}, {"height", r.height}, {"seconds", r.seconds},
+                          {"peak_memory_mb", nonneg(r.peak_memory_mb)}});
+    }
     const ScalingFit fit = fit_scaling(rs);
     fits.push_back({{"filter", fit.filter}, {"input", fit.input}, {"slope", fit.slope},
                     {"seconds_per_megapixel", fit.seconds_per_megapixel},
@@ -421,7 +449,10 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
            "a sample frame mirrored (... c b a | a b c | c b a ...) to each size: every pass, the per-sample and "
            "light-field data alike, so that the work per pixel stays that of the sample; filter time only (in the "
            "process, no I/O), best of the repeats; peak = resident memory the run added"},
-          {"sources", src_json}, {"threads", c.threads}, {"sizes", sizes}, {"rows", rows}, {"fits", fits}};
+          {"sources", src_json}, {"threads", c.threads}, {"sizes", sizes}, {"rows", rows}, {"fits", fits},
+          {"spp_method", "each render of one scene per input kind (" + std::to_string(spp_side) + "x" +
+                             std::to_string(spp_side) + " by the same tiling), filter time against its spp"},
+          {"spp_rows", spp_rows}};
 }
 
 std::string csv_line(const std::vector<std::string>& cells) {

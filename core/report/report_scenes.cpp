@@ -36,7 +36,7 @@ ReportScene from_manifest(const SampleScene& s, int spp) {
     r.frames_text = FrameList::span(s.first_frame, s.last_frame).text();
   }
   for (const auto& [n, path] : s.noisy) {
-    ReportLevel level{n, {}};
+    ReportLevel level{n, {}, {}};
     for (int f : r.frames) level.paths.push_back(s.is_sequence() ? sequence_path(path, f) : path);
     r.levels.push_back(level);
   }
@@ -69,7 +69,7 @@ std::vector<ReportScene> per_sample_scenes(const fs::path& dir) {
     r.noisy = {deep};  // the image-space filters get its flattened passes
     r.deep = {deep};
     r.reference = {(dir / s.at("reference").get<std::string>()).string()};
-    if (r.spp > 0) r.levels = {{r.spp, {deep}}};
+    if (r.spp > 0) r.levels = {{r.spp, {deep}, {deep}}};
     out.push_back(r);
   }
   return out;
@@ -91,8 +91,8 @@ std::vector<ReportScene> light_field_scenes(const fs::path& dir, const std::vect
     std::vector<ReportLevel> levels;
     for (int n = 1; n <= 64; ++n) {
       const fs::path flat = dir / (name + "_lf_" + std::to_string(n) + "spp_flat.exr");
-      if (fs::is_regular_file(flat) && fs::is_regular_file(dir / (name + "_lf_" + std::to_string(n) + "spp.exr")))
-        levels.push_back({n, {flat.string()}});
+      const fs::path lf = dir / (name + "_lf_" + std::to_string(n) + "spp.exr");
+      if (fs::is_regular_file(flat) && fs::is_regular_file(lf)) levels.push_back({n, {flat.string()}, {lf.string()}});
     }
     if (levels.empty()) continue;
     // The highest level asked for that the light field has, else its highest.
@@ -174,7 +174,7 @@ ReportScene user_report_scene(const std::string& name, const std::string& noisy,
       if (!fs::is_regular_file(path))
         throw Error(Errc::FileNotFound, std::string(flag) + " '" + path + "': no such file");
   }
-  if (spp > 0) r.levels.push_back({spp, r.noisy});
+  if (spp > 0) r.levels.push_back({spp, r.noisy, r.deep});
   return r;
 }
 

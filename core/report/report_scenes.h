@@ -11,6 +11,7 @@ namespace mcr {
 struct ReportLevel {
   int spp = 0;
   std::vector<std::string> paths;  // per frame, flat files
+  std::vector<std::string> deep;   // per frame, the per-sample / light-field twins (empty: none)
 };
 
 struct ReportScene {
