@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # mcrecon setup: install Debian 12 packages, configure and build.
 #   bash setup.sh          install + build
-#   bash setup.sh demo     install + build + run the demo on the embedded sample scenes
+#   bash setup.sh demo     install + build + the report on the embedded sample scenes (demo_out/report.html)
 #   bash setup.sh test     install + build + run every test (ctest)
 #   bash setup.sh sanitize install + an ASan+UBSan clang build in build-asan (with the libFuzzer
 #                          targets) + its ctest: unit, CLI, plugin and Python module tests under the
@@ -55,7 +55,8 @@ cmake --build "$BUILD_DIR" -j "$JOBS"
 
 case "${1:-build}" in
   build) ;;
-  demo) shift; "$BUILD_DIR/bin/mcrecon" demo --out "${DEMO_OUT:-demo_out}" "$@" ;;
+  # The report on every sample scene: demo_out/report.html, results.json, results.csv (issue 20).
+  demo) shift; "$BUILD_DIR/bin/mcrecon" report --out "${DEMO_OUT:-demo_out}" "$@" ;;
   test) ctest --test-dir "$BUILD_DIR" --output-on-failure -j "$JOBS" ;;
   *) echo "setup: unknown action '$1' (use build, demo, test or sanitize)" >&2; exit 2 ;;
 esac

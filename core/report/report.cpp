@@ -149,6 +149,7 @@ struct Context {
   std::vector<std::string> filters;
   json scenes = json::array();
   std::vector<std::vector<std::string>> csv;
+  std::string cpu;  // for every CSV row: a row read alone says where it was measured
   int runs = 0, failed = 0;
   void log(const std::string& line) const {
     if (o.log) o.log(line);
@@ -171,7 +172,8 @@ void add_csv(Context& c, const json& scene, const json& row, const std::string& 
                    cell(row.value("filter_seconds", json(nullptr))), cell(row.value("peak_memory_mb", json(nullptr))),
                    cell(row["relmse"]), cell(row["psnr"]), cell(row["ssim"]), cell(row["temporal_error"]),
                    cell(row.value("worth_x_samples", json(nullptr))), cell(scene["width"]), cell(scene["height"]),
-                   cell(json(double(scene["width"].get<int>()) * scene["height"].get<int>())), cell(scene["timing"])});
+                   cell(json(double(scene["width"].get<int>()) * scene["height"].get<int>())), cell(scene["timing"]),
+                   std::to_string(c.threads), c.cpu});
 }
 
 json run_json(const ReportScene& sc, const RunResult& r) {
@@ -317,7 +319,7 @@ void report_scene(Context& c, const ReportScene& scene, int index, int count) {
              {"kind", sc.kind},      {"split", sc.split},
              {"width", s.flat.front().width}, {"height", s.flat.front().height},
              {"frames", int(sc.frames.size())}, {"reference_spp", sc.reference_spp},
-             {"timing", c.command_timing ? "command" : "in-process"}};
+             {"timing", c.command_timing ? "command" : c.peers.empty() ? "in-process" : "mixed"}};
   if (sc.spp <= 0) sj["input"] = "input";
 
   // The renders of this scene at known spp: the reference points of the plots.
@@ -428,7 +430,7 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
       c.csv.push_back({"scaling", source_names[kind], "", "", kind, r.filter, "", "true", value_text(r.seconds), "",
                        r.peak_memory_mb >= 0 ? value_text(r.peak_memory_mb) : "", "", "", "", "", "",
                        std::to_string(r.width), std::to_string(r.height), value_text(double(r.width) * r.height),
-                       "in-process"});
+                       "in-process", std::to_string(c.threads), c.cpu});
     }
     for (const auto& [spp, frame] : by_spp[kind]) {
       if (!f->missing_passes(frame).empty()) continue;
@@ -543,6 +545,8 @@ ReportSummary run_report(const ReportOptions& o) {
     throw Error(Errc::InvalidArgument, "--timing command: the mcrecon CLI was not found ('" + o.cli +
                                            "'); in Python pass cli=PATH");
 
+  const json machine = machine_json(c.threads);
+  c.cpu = machine["cpu"].get<std::string>();
   c.log(std::string("timing: ") + (c.command_timing ? "every run as a command (peers present)" : "in the process"));
   for (std::size_t i = 0; i < scenes.size(); ++i) report_scene(c, scenes[i], int(i) + 1, int(scenes.size()));
 
@@ -550,7 +554,7 @@ ReportSummary run_report(const ReportOptions& o) {
       {"format", "mcrecon-report-1"},
       {"created", now_utc()},
       {"mcrecon", "mcrecon 0.1.0"},
-      {"machine", machine_json(c.threads)},
+      {"machine", machine},
       {"timing_note",
        c.command_timing
            ? "command: each run is a process (mcrecon denoise for the filters, the template for peers), timed by "
@@ -572,7 +576,7 @@ ReportSummary run_report(const ReportOptions& o) {
   write_text_atomic(results.dump(1) + "\n", sum.results_json);
   std::string csv = csv_line({"section", "scene", "input", "spp", "kind", "filter", "parameters", "default", "seconds",
                               "filter_seconds", "peak_memory_mb", "relmse", "psnr", "ssim", "temporal_error",
-                              "worth_x_samples", "width", "height", "pixels", "timing"});
+                              "worth_x_samples", "width", "height", "pixels", "timing", "threads", "cpu"});
   for (const auto& row : c.csv) csv += csv_line(row);
   write_text_atomic(csv, sum.results_csv);
   sum.scenes = int(scenes.size());

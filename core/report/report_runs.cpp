@@ -1,5 +1,6 @@
 #include "report/report_runs.h"
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -127,6 +128,22 @@ double parse_filter_ms(const std::string& log) {
   return ms;
 }
 
+// The notes `mcrecon denoise --verbose` printed ("mcrecon: FILE: note"; not its timing lines),
+// once each, and auto's choice from "auto: chose X with ..." / "auto: chose the input ...".
+void take_notes(const std::string& log, RunResult& r) {
+  std::istringstream in(log);
+  for (std::string line; std::getline(in, line);) {
+    if (line.rfind("mcrecon: ", 0) != 0) continue;
+    const std::size_t colon = line.find(": ", 9);
+    if (colon == std::string::npos) continue;
+    const std::string note = line.substr(colon + 2);
+    if (note.rfind("read ", 0) == 0) continue;  // "read 24 ms, filter 12 ms, ..."
+    if (std::find(r.notes.begin(), r.notes.end(), note) == r.notes.end() && r.notes.size() < 40) r.notes.push_back(note);
+    if (note.rfind("auto: chose the input", 0) == 0) r.chosen = "input";
+    else if (note.rfind("auto: chose ", 0) == 0) r.chosen = note.substr(12, note.find(' ', 12) - 12);
+  }
+}
+
 std::string read_all(const std::string& path) {
   std::ifstream in(path);
   std::stringstream ss;
@@ -167,7 +184,8 @@ RunResult run_as_command(const LoadedReportScene& s, const std::string& filter, 
   const bool sequence = !sc.frames_text.empty();
   const std::string tag = filter + (set.empty() ? "" : "_" + std::to_string(std::hash<std::string>{}(set) % 100000));
   const std::string out = (fs::path(timing.work_dir) / (sc.id + "_" + tag + (sequence ? "_####.exr" : ".exr"))).string();
-  std::vector<std::string> argv = {timing.cli, "denoise", "-f", filter, "--timings", "-j", std::to_string(timing.nthreads)};
+  // --verbose: the timings and the filter's notes (auto's choice among them).
+  std::vector<std::string> argv = {timing.cli, "denoise", "-f", filter, "--verbose", "-j", std::to_string(timing.nthreads)};
   if (!set.empty()) argv.insert(argv.end(), {"--set", set});
   if (sequence) argv.insert(argv.end(), {"--frames", sc.frames_text});
   argv.push_back(sequence ? (deep_input ? sc.deep_pattern : sc.noisy_pattern) : (deep_input ? sc.deep[0] : sc.noisy[0]));
@@ -180,8 +198,10 @@ RunResult run_as_command(const LoadedReportScene& s, const std::string& filter, 
   }
   r.seconds = run.seconds;
   r.peak_memory_mb = run.peak_memory_mb;
-  const double ms = parse_filter_ms(read_all(log));
+  const std::string text = read_all(log);
+  const double ms = parse_filter_ms(text);
   r.filter_seconds = ms >= 0 ? ms / 1000.0 : -1;
+  take_notes(text, r);
   std::vector<std::string> files;
   for (int f : sc.frames) files.push_back(sequence ? sequence_path(out, f) : out);
   r.outputs = read_outputs(files, s, r);

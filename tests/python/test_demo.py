@@ -1,4 +1,4 @@
-"""`mcrecon demo` end to end (what `bash setup.sh demo` runs): every sample scene gets a row per
+"""`mcrecon demo` end to end (the quick table; `bash setup.sh demo` runs `mcrecon report`, tested by py_test_report*): every sample scene gets a row per
 filter, a side-by-side PNG whose tiles are the noisy input, each filter and the reference, and
 results.json; the noisy rows agree with `mcrecon compare` run on the same files."""
 import json

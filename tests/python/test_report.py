@@ -78,6 +78,8 @@ class ReportTest(unittest.TestCase):
                 for r in s["runs"]:
                     self.assertNotIn("error", r, r)
                     self.assertIsNotNone(r["relmse"], r["id"])
+                auto = [r for r in s["runs"] if r["filter"] == "auto"][0]
+                self.assertTrue(auto["chosen"], auto)  # what it picked (or "input"), from its notes
                 # A sweep of box's radius besides its defaults.
                 self.assertGreaterEqual(len([r for r in s["runs"] if r["filter"] == "box" and r["sweep"]]), 3)
 
