@@ -227,8 +227,13 @@ def place_labels(ax, items, fontsize=7):
                     ha="left" if best[0] >= 0 else "right", va="bottom", color="0.15")
 
 
-def pareto_plot(scene, key, path):
-    """Run time (log) against relMSE (log) or SSIM (linear); returns the runs left out."""
+# The second view of a command-timed scene: what the filter itself costs, without the process.
+FILTER_TIME_TEXT = "time: mcrecon's own filter time (--timings: no start-up, reading or writing; peers have none)"
+
+
+def pareto_plot(scene, key, path, xkey="seconds"):
+    """Run time (log) against relMSE (log) or SSIM (linear); returns the runs left out.
+    xkey "filter_seconds": mcrecon's own filter time of command-timed runs (peers have none)."""
     runs = scene.get("runs") or []
     log_y = key == "relmse"
     colours = filter_colours(runs)
@@ -236,7 +241,7 @@ def pareto_plot(scene, key, path):
     left_out = []
 
     def ok(r):
-        s, v = r.get("seconds"), r.get(key)
+        s, v = r.get(xkey), r.get(key)
         good = is_num(s) and s > 0 and is_num(v) and (v > 0 or not log_y)
         if not good:
             left_out.append(r.get("id"))
@@ -251,8 +256,8 @@ def pareto_plot(scene, key, path):
     for (f, param), rs in sweeps.items():
         rs.sort(key=lambda r: r["sweep"].get("value") if is_num(r["sweep"].get("value")) else 0)
         c = colours.get(f, "0.5")
-        ax.plot([r["seconds"] for r in rs], [r[key] for r in rs], "-", lw=0.7, color=c, zorder=2)
-        ax.scatter([r["seconds"] for r in rs], [r[key] for r in rs], s=28, facecolors="white",
+        ax.plot([r[xkey] for r in rs], [r[key] for r in rs], "-", lw=0.7, color=c, zorder=2)
+        ax.scatter([r[xkey] for r in rs], [r[key] for r in rs], s=28, facecolors="white",
                    edgecolors=[c], linewidths=1.1, zorder=3, label=mt("%s: sweep of %s" % (f, param)))
     marker = {"filter": "o", "auto": "*", "peer": "D"}
     size = {"filter": 40, "auto": 150, "peer": 45}
@@ -263,14 +268,14 @@ def pareto_plot(scene, key, path):
         kind = r.get("kind", "filter")
         c = colours.get(r.get("filter") or r.get("id"), "0.5")
         filled = r.get("default", True) or kind != "filter"
-        ax.scatter([r["seconds"]], [r[key]], marker=marker.get(kind, "o"), s=size.get(kind, 40),
+        ax.scatter([r[xkey]], [r[key]], marker=marker.get(kind, "o"), s=size.get(kind, 40),
                    facecolors=[c] if filled else "white", edgecolors="black" if filled else [c],
                    linewidths=0.6, zorder=4)
         if filled:
-            labels.append((r["seconds"], r[key], mt(run_label(r))))
-    front = sorted((r for r in shown if r.get("pareto_" + key)), key=lambda r: r["seconds"])
+            labels.append((r[xkey], r[key], mt(run_label(r))))
+    front = sorted((r for r in shown if r.get("pareto_" + key)), key=lambda r: r[xkey]) if xkey == "seconds" else []
     if front:
-        ax.step([r["seconds"] for r in front], [r[key] for r in front], where="post", color="0.2",
+        ax.step([r[xkey] for r in front], [r[key] for r in front], where="post", color="0.2",
                 lw=1.3, alpha=0.7, zorder=1)
     for lv in scene.get("levels") or []:
         v = lv.get(key)
@@ -281,11 +286,12 @@ def pareto_plot(scene, key, path):
     ax.set_xscale("log")
     if log_y:
         ax.set_yscale("log")
-    ax.set_xlabel("run time, seconds (log)")
+    ax.set_xlabel("run time, seconds (log)" if xkey == "seconds" else "filter time, seconds (log)")
     ax.set_ylabel("relMSE (log, lower is better)" if log_y else "SSIM (higher is better)")
     ax.grid(True, which="major", lw=0.4, alpha=0.5)
     ax.set_title(mt("%s: %s against time\n%s" % (scene.get("id"), "relMSE" if log_y else "SSIM",
-                                               TIMING_TEXT.get(scene.get("timing"), "time: %s" % scene.get("timing"))),
+                                               TIMING_TEXT.get(scene.get("timing"), "time: %s" % scene.get("timing"))
+                                               if xkey == "seconds" else FILTER_TIME_TEXT),
                  ), fontsize=10)
     place_labels(ax, labels)
     handles = [
@@ -603,6 +609,10 @@ def scene_html(scene, idx, n, out_dir, plots_dir, images):
         name = "%s_pareto_%s.png" % (base, key)
         pareto_plot(scene, key, os.path.join(plots_dir, name))
         out.append(images.img("plots/" + name, "%s against time" % key, "plot"))
+    if timing == "command":  # process times are mostly start-up on small frames: the filters' own too
+        name = "%s_filter_time_relmse.png" % base
+        pareto_plot(scene, "relmse", os.path.join(plots_dir, name), xkey="filter_seconds")
+        out.append(images.img("plots/" + name, "relmse against filter time", "plot"))
     out.append("<h3>Runs (sorted by relMSE)</h3>" + runs_table(scene))
     out.append("<h3>Renders of the scene</h3>" + levels_table(scene))
     locator = "%s_crops.png" % base

@@ -260,6 +260,8 @@ class ReportPageTest(unittest.TestCase):
                          "%s_errors.png" % s["id"], "%s_crops.png" % s["id"]]
             if s["frames"] > 1:
                 expected += ["%s_frames_relmse.png" % s["id"], "%s_frames_temporal_error.png" % s["id"]]
+            if s["timing"] == "command":  # the filters' own time too
+                expected += ["%s_filter_time_relmse.png" % s["id"]]
         expected += ["scaling_memory.png", "scaling_time.png"]
         self.assertEqual(names, sorted(expected))
         embedded = set(self.parsed.imgs)
