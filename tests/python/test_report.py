@@ -240,6 +240,30 @@ class ReportBadInputTest(unittest.TestCase):
         self.assertIn("peer-broke", bad["error"])
         self.assertIsNone(bad["relmse"])
 
+    def test_a_user_sequence_with_a_peer(self):
+        anim = os.path.join(DATA, "anim")
+        tu.run_cli("report", "-o", os.path.join(self.tmp, "o"), "--input", os.path.join(anim, "anim_1spp_####.exr"),
+                   "--reference", os.path.join(anim, "anim_ref_####.exr"), "--frames", "2-5", "--name", "shot",
+                   "--filters", "box", "bmfr", "--no-sweeps", "--scaling-max", "0", "--no-builtin-peers", "--no-page",
+                   "--peer", BLUR)
+        with open(os.path.join(self.tmp, "o", "results.json")) as f:
+            s = json.load(f)["scenes"][0]
+        self.assertEqual((s["id"], s["kind"], s["frames"], s["timing"]), ("shot", "sequence", 4, "command"))
+        self.assertEqual(sorted(r["id"] for r in s["runs"]), ["bmfr", "box", "peer_blur"])
+        for r in s["runs"]:
+            pf = r["per_frame"]
+            self.assertEqual(pf["frame"], [2, 3, 4, 5])
+            self.assertIsNone(pf["temporal_error"][0])
+            self.assertAlmostEqual(sum(pf["temporal_error"][1:]) / 3, r["temporal_error"], delta=1e-12)
+            self.assertAlmostEqual(sum(pf["relmse"]) / 4, r["relmse"], delta=1e-12)
+        # the sequence's input level against `mcrecon compare` per frame
+        got = tu.run_cli_json("compare", "--json", os.path.join(anim, "anim_ref_####.exr"),
+                              os.path.join(anim, "anim_1spp_####.exr"), "--frames", "2-5")
+        level = s["levels"][0]
+        self.assertIsNone(level["spp"])
+        self.assertAlmostEqual(level["relmse"], got["relmse"], delta=1e-12)
+        self.assertAlmostEqual(level["temporal_error"], got["temporal_error"], delta=1e-12)
+
     def test_two_runs_never_share_a_folder(self):
         out = os.path.join(self.tmp, "o")
         os.makedirs(out)
