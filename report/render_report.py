@@ -133,32 +133,13 @@ class Images:
         return '<img class="%s" src="%s" alt="%s">' % (esc(cls), u, esc(alt))
 
 
-def read_png(path):
-    """A PNG as float RGB in [0, 1] (for the crop locator thumbnail), or None."""
+def read_float(path, warn):
+    """An image file as (channel names, float32 H x W x C array), or None (a warning when `warn`)."""
     import OpenImageIO as oiio
     inp = oiio.ImageInput.open(path)
     if inp is None:
-        return None
-    try:
-        px = inp.read_image(oiio.FLOAT)
-    finally:
-        inp.close()
-    if px is None:
-        return None
-    px = np.asarray(px, dtype=np.float32)
-    if px.ndim == 2:
-        px = px[:, :, None]
-    if px.shape[2] == 1:
-        px = np.repeat(px, 3, axis=2)
-    return np.clip(px[:, :, :3], 0.0, 1.0)
-
-
-def read_error_map(path):
-    """A run's error EXR: the 'Y' channel (else the first) as a float32 2-D array, or None."""
-    import OpenImageIO as oiio
-    inp = oiio.ImageInput.open(path)
-    if inp is None:
-        log("warning: cannot read error map %s: %s" % (path, oiio.geterror()))
+        if warn:
+            log("warning: cannot read %s: %s" % (path, oiio.geterror()))
         return None
     try:
         names = list(inp.spec().channelnames)
@@ -168,8 +149,26 @@ def read_error_map(path):
     if px is None:
         return None
     px = np.asarray(px, dtype=np.float32)
-    if px.ndim == 2:
-        return px
+    return names, (px[:, :, None] if px.ndim == 2 else px)
+
+
+def read_png(path):
+    """A PNG as float RGB in [0, 1] (for the crop locator thumbnail), or None."""
+    got = read_float(path, False)
+    if got is None:
+        return None
+    px = got[1]
+    if px.shape[2] == 1:
+        px = np.repeat(px, 3, axis=2)
+    return np.clip(px[:, :, :3], 0.0, 1.0)
+
+
+def read_error_map(path):
+    """A run's error EXR: the 'Y' channel (else the first) as a float32 2-D array, or None."""
+    got = read_float(path, True)
+    if got is None:
+        return None
+    names, px = got
     return px[:, :, names.index("Y") if "Y" in names else 0]
 
 

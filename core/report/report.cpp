@@ -1,11 +1,13 @@
 #include "report/report.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <sys/file.h>
 #include <sys/utsname.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <ctime>
@@ -15,6 +17,7 @@
 #include <sstream>
 #include <thread>
 
+#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_write.h"
@@ -228,7 +231,12 @@ void run_filter(Context& c, const LoadedReportScene& s, const std::string& name,
       auto f = make_catalog_filter(name);
       if (!set.empty()) f->set_text(sweep.param, value_text(value));
       f->commit();
-      r = run_in_process(s, *f, *frames, c.threads);
+      try {
+        r = run_in_process(s, *f, *frames, c.threads);
+      } catch (const Error& e) {  // one setting that fails is a row, not the end of the report
+        r = RunResult{};
+        r.error = e.what();
+      }
     }
     r.filter = name;
     r.parameters = set;
@@ -457,6 +465,23 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
           {"spp_rows", spp_rows}};
 }
 
+// A run stopped by a signal leaves its OUT/.work-PID folder: removed by the next run when that
+// process is gone.
+void remove_stale_work_dirs(const fs::path& out) {
+  std::error_code ec;
+  for (const auto& e : fs::directory_iterator(out, ec)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind(".work-", 0) != 0) continue;
+    const long pid = std::strtol(name.c_str() + 6, nullptr, 10);
+    if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
+  }
+}
+
+void check_image_header(const std::string& path) {
+  auto in = OIIO::ImageInput::open(path);
+  if (!in) throw Error(Errc::NotAnImage, "'" + path + "' is not an image OpenImageIO can read: " + OIIO::geterror());
+}
+
 std::string csv_line(const std::vector<std::string>& cells) {
   std::string line;
   for (std::size_t i = 0; i < cells.size(); ++i) {
@@ -499,7 +524,13 @@ ReportSummary run_report(const ReportOptions& o) {
   for (const std::string& p : o.peers) c.peers.push_back(parse_peer(p));
 
   std::vector<ReportScene> scenes;
-  for (const ReportInput& in : o.inputs) scenes.push_back(user_report_scene(in.name, in.noisy, in.reference, in.frames, in.spp));
+  for (const ReportInput& in : o.inputs) {
+    scenes.push_back(user_report_scene(in.name, in.noisy, in.reference, in.frames, in.spp));
+    // Every file opens as an image before any work: a bad reference is found now, not after the
+    // sample scenes ran.
+    for (const auto* list : {&scenes.back().noisy, &scenes.back().reference})
+      for (const std::string& path : *list) check_image_header(path);
+  }
   if (o.with_samples) {
     const std::string dir = o.samples.empty() ? default_samples_dir() : o.samples;
     for (ReportScene& s : sample_report_scenes(dir, o.spp, o.scenes)) scenes.push_back(std::move(s));
@@ -538,6 +569,7 @@ ReportSummary run_report(const ReportOptions& o) {
             " is missing");
   }
   c.command_timing = o.timing == "command" || (o.timing == "auto" && !c.peers.empty());
+  remove_stale_work_dirs(c.out);
   WorkDir work{c.out / (".work-" + std::to_string(::getpid()))};
   fs::create_directories(work.path);
   c.timing = {o.cli, work.path.string(), c.threads, o.command_timeout};

@@ -227,6 +227,10 @@ class ReportBadInputTest(unittest.TestCase):
         self.assertIn("nope", self.run_bad("--filters", "nope"))
         self.assertIn("no sample scene 'nope'", self.run_bad("--scenes", "nope"))
         self.assertIn("missing.exr", self.run_bad("--input", os.path.join(self.tmp, "missing.exr"), "--reference", WALL_REF))
+        text = os.path.join(self.tmp, "notes.exr")
+        with open(text, "w") as f:
+            f.write("not an image\n")
+        self.assertIn("notes.exr", self.run_bad("--input", WALL4, "--reference", text))  # found before any work
         self.assertFalse(os.path.exists(os.path.join(self.tmp, "o", "results.json")))
 
     def test_a_failing_peer_is_reported_not_fatal(self):
