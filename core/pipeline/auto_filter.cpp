@@ -31,7 +31,15 @@ Frame crop(const Frame& f, const Roi& r) {
   c.layer = f.layer;
   c.frame_number = f.frame_number;
   for (const Pass& p : f.passes) {
-    Pass q = p;
+    // Every field but the pixels: copying the whole image first cost a frame's worth of every
+    // pass per tile (42 tiles of a 4 MP frame moved 20 GB, 3x the filter's own time).
+    Pass q;
+    q.role = p.role;
+    q.name = p.name;
+    q.source = p.source;
+    q.channels = p.channels;
+    q.space = p.space;
+    q.priority = p.priority;
     const int ch = p.image.channels();
     q.image = Image(c.width, c.height, ch);
     for (int y = 0; y < c.height; ++y) {
