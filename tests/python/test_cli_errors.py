@@ -460,7 +460,7 @@ class CliErrorTest(_TempDirCase):
         self.assertLess(len(proc.stderr), 300, proc.stderr)
 
     def test_command_line_errors_name_what_was_typed(self):
-        commands = "commands: info, filters, denoise, compare, plan, sparsify, lightfield, demo"
+        commands = "commands: info, filters, denoise, compare, plan, sparsify, lightfield, report, demo"
         self.assert_user_error(["frobnicate"], ["unknown command 'frobnicate'; " + commands])
         self.assert_user_error(["frobnicate", "--filter", "box"], ["unknown command 'frobnicate'"])
         self.assert_user_error([], ["no command given; " + commands])
