@@ -102,7 +102,7 @@ int main(int argc, char** argv) {
     const Run a = time_filter("auto", frame, ref, threads, repeat);
     double picked = 0;
     for (const std::string& name : mcr::image_filter_names()) {
-      if (mcr::filter_info(name).temporal) continue;
+      if (mcr::filter_info(name).temporal || mcr::filter_info(name).deep_input) continue;
       const Run r = time_filter(name, frame, ref, threads, repeat);
       if (name == a.chosen) picked = r.seconds;
       std::printf("%-9s %-6s %-10s %9.4f %9.4f %10.5f\n", scene.name.c_str(), scene.split.c_str(), name.c_str(), r.seconds,
@@ -131,7 +131,7 @@ int main(int argc, char** argv) {
                                                   mcr::read_frame(scene.halves.at(spp).second));
     const mcr::Image ref = mcr::read_frame(scene.reference).image(mcr::Role::Colour).channel_range(0, 3);
     for (const std::string& name : mcr::catalog_names()) {
-      if (mcr::catalog_info(name).temporal) continue;
+      if (mcr::catalog_info(name).temporal || mcr::catalog_info(name).deep_input) continue;  // stills, flat
       const Run a = time_filter(name, single, ref, threads, 1), b = time_filter(name, halves, ref, threads, 1);
       std::printf("%-9s %-10s %10.5f %10.5f %s%s\n", scene.name.c_str(), name.c_str(), a.relmse, b.relmse,
                   a.chosen.empty() ? "" : ("chose " + a.chosen + " | " + b.chosen).c_str(), "");
