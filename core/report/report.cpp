@@ -440,7 +440,9 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
                        std::to_string(r.width), std::to_string(r.height), value_text(double(r.width) * r.height),
                        "in-process", std::to_string(c.threads), c.cpu});
     }
-    for (const auto& [spp, frame] : by_spp[kind]) {
+    for (const auto& level : by_spp[kind]) {
+      const int spp = level.first;  // a plain variable: clang's C++17 cannot capture a structured binding
+      const Frame& frame = level.second;
       if (!f->missing_passes(frame).empty()) continue;
       const ScalingRow r =
           measure_scaling(*f, frame, kind, {spp_side}, c.threads, c.o.repeat, [&](const std::string& l) {
