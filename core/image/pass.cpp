@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cctype>
+#include <utility>
 
 #include "util/error.h"
 
@@ -101,6 +102,29 @@ const Pass& Frame::get(Role r, Prefer p) const {
   if (const Pass* pass = find(r, p)) return *pass;
   throw Error(Errc::MissingPass, std::string("no ") + role_name(r) + " pass in '" + path + "'" +
                                      (layer.empty() ? "" : " (layer '" + layer + "')"));
+}
+
+Pass with_pixels(const Pass& p, Image image) {
+  Pass q;
+  q.role = p.role;
+  q.name = p.name;
+  q.source = p.source;
+  q.channels = p.channels;
+  q.space = p.space;
+  q.priority = p.priority;
+  q.image = std::move(image);
+  return q;
+}
+
+Frame Frame::header(int w, int h) const {
+  Frame f;
+  f.width = w;
+  f.height = h;
+  f.path = path;
+  f.layer = layer;
+  f.layers = layers;
+  f.frame_number = frame_number;
+  return f;
 }
 
 void Frame::put(Pass p) {

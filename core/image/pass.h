@@ -59,6 +59,10 @@ struct Pass {
   Image image;
 };
 
+// The pass with other pixels (a crop, an enlargement): every other field kept, the old pixels
+// never copied.
+Pass with_pixels(const Pass& p, Image image);
+
 // Which candidate of a role a filter prefers. Blender writes both a filtered
 // camera-space "Denoising Normal" and a world-space "Normal".
 enum class Prefer { Feature, Geometry };
@@ -93,6 +97,10 @@ class Frame {
   // Throws Errc::MissingPass naming the role and the file.
   const Pass& get(Role r, Prefer p = Prefer::Feature) const;
   const Image& image(Role r, Prefer p = Prefer::Feature) const { return get(r, p).image; }
+
+  // A frame of width x height that names the same file, layer and frame number, with no passes,
+  // samples or window (a crop, an enlargement or a split of this one fills them).
+  Frame header(int w, int h) const;
 
   // Adds or replaces the pass of that role (same name replaces, else appended).
   void put(Pass p);

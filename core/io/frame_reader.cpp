@@ -207,16 +207,23 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
   }
 }
 
-RawImage read_raw(const std::string& path) {
-  require_regular_file(path);  // before any open(): a FIFO would block it
-  check_exr_header_sizes(path);  // before OpenEXR allocates what the header claims
+// The file opened, after the checks every read needs: a regular file (a FIFO would block the
+// open), header sizes OpenEXR may allocate, then the header against what the file can hold.
+std::unique_ptr<ImageInput> open_checked(const std::string& path, InputBudget& budget) {
+  require_regular_file(path);
+  check_exr_header_sizes(path);
   auto in = ImageInput::open(path);
   if (!in) {
     std::string msg = OIIO::geterror();
     throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
   }
-  // Every allocation below is sized by the header: check it against what the file can hold first.
-  const InputBudget budget = check_header_fits(*in, path);
+  budget = check_header_fits(*in, path);
+  return in;
+}
+
+RawImage read_raw(const std::string& path) {
+  InputBudget budget;
+  auto in = open_checked(path, budget);
   const ImageSpec spec = in->spec();
   RawImage raw;
   raw.width = spec.width;
@@ -400,6 +407,11 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
 }
 
 }  // namespace
+
+void check_image_file(const std::string& path) {
+  InputBudget budget;
+  open_checked(path, budget);
+}
 
 Frame read_frame(const std::string& path, const ReadOptions& options) {
   if (!options.second_half.empty()) {

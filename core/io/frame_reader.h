@@ -34,6 +34,11 @@ std::vector<std::string> loose_pass_files(const ReadOptions& options);
 // SizeMismatch, each naming the file and pass.
 Frame read_frame(const std::string& path, const ReadOptions& options = {});
 
+// The checks read_frame makes before reading pixels (a regular file, an image, a header its
+// bytes can back), without reading them: for front ends that take many files and should fail
+// on a bad one before any work. Throws as read_frame.
+void check_image_file(const std::string& path);
+
 // The same frame from channels already in memory (interleaved float, one name per
 // channel, as read_frame would find them in `path`, which names them in messages):
 // same layer choice, roles, overrides and checks. For front ends that receive

@@ -125,13 +125,7 @@ void check_light_passes(const Frame& frame) {
 }
 
 Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads, LightPart part) {
-  Frame out;
-  out.width = frame.width;
-  out.height = frame.height;
-  out.path = frame.path;
-  out.layer = frame.layer;
-  out.layers = frame.layers;
-  out.frame_number = frame.frame_number;
+  Frame out = frame.header(frame.width, frame.height);
   out.window = frame.window;
   out.deep = frame.deep;
   const Pass& direct = frame.get(component.direct);

@@ -220,11 +220,15 @@ CommandRun run_timed_command(const std::vector<std::string>& argv, const std::st
   return run;
 }
 
-std::string log_tail(const std::string& log, std::size_t max_chars) {
+std::string read_log(const std::string& log) {
   std::ifstream in(log);
   std::stringstream ss;
   ss << in.rdbuf();
-  const std::string s = ss.str();
+  return ss.str();
+}
+
+std::string log_tail(const std::string& log, std::size_t max_chars) {
+  const std::string s = read_log(log);
   return s.size() > max_chars ? "..." + s.substr(s.size() - max_chars) : s;
 }
 

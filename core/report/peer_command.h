@@ -39,6 +39,8 @@ struct CommandRun {
 // `timeout_seconds` (then kills it). Throws Internal when it cannot be started.
 CommandRun run_timed_command(const std::vector<std::string>& argv, const std::string& log, double timeout_seconds);
 
+// A log file's whole text ("" when it cannot be read).
+std::string read_log(const std::string& log);
 // The last `max_chars` of a log file, for error messages.
 std::string log_tail(const std::string& log, std::size_t max_chars = 600);
 

@@ -14,10 +14,8 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
-#include <sstream>
 #include <thread>
 
-#include <OpenImageIO/imageio.h>
 #include <nlohmann/json.hpp>
 
 #include "io/atomic_write.h"
@@ -135,12 +133,6 @@ void mark_pareto(std::vector<RunResult>& runs) {
   }
 }
 
-std::string value_text(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
-}
-
 struct Context {
   Context(const ReportOptions& options, int nthreads) : o(options), out(options.out), threads(nthreads) {}
   const ReportOptions& o;
@@ -164,10 +156,7 @@ void add_csv(Context& c, const json& scene, const json& row, const std::string& 
     if (v.is_null()) return "";
     if (v.is_string()) return v.get<std::string>();
     if (v.is_boolean()) return v.get<bool>() ? "true" : "false";
-    std::ostringstream o;
-    o.precision(17);
-    o << v.get<double>();
-    return o.str();
+    return number_text(v.get<double>());  // the fewest digits that read back as the JSON's value
   };
   c.csv.push_back({section, cell(scene["scene"]), cell(scene["input"]), cell(scene["spp"]), cell(scene["kind"]),
                    cell(row.value("filter", json(row.value("label", "")))), cell(row.value("parameters", json(""))),
@@ -220,7 +209,7 @@ void run_filter(Context& c, const LoadedReportScene& s, const std::string& name,
   if (c.o.sweeps && !sweep.param.empty()) {
     const std::string def = param_value_text(probe->params().values().at(sweep.param));
     for (double v : sweep.values)
-      if (value_text(v) != def) settings.push_back({sweep.param + "=" + value_text(v), v});
+      if (number_text(v) != def) settings.push_back({sweep.param + "=" + number_text(v), v});
   }
   for (const auto& [set, value] : settings) {
     RunResult r;
@@ -228,11 +217,14 @@ void run_filter(Context& c, const LoadedReportScene& s, const std::string& name,
       r = run_as_command(s, name, set, probe->info().deep_input, c.timing);
       if (name == "auto") r.kind = "auto";
     } else {
-      auto f = make_catalog_filter(name);
-      if (!set.empty()) f->set_text(sweep.param, value_text(value));
-      f->commit();
+      std::unique_ptr<Filter> swept;
+      if (!set.empty()) {
+        swept = make_catalog_filter(name);
+        swept->set_text(sweep.param, number_text(value));
+        swept->commit();
+      }
       try {
-        r = run_in_process(s, *f, *frames, c.threads);
+        r = run_in_process(s, set.empty() ? *probe : *swept, *frames, c.threads);
       } catch (const Error& e) {  // one setting that fails is a row, not the end of the report
         r = RunResult{};
         r.error = e.what();
@@ -241,7 +233,7 @@ void run_filter(Context& c, const LoadedReportScene& s, const std::string& name,
     r.filter = name;
     r.parameters = set;
     r.is_default = set.empty();
-    r.id = set.empty() ? name : safe_name(name + "_" + sweep.param + "_" + value_text(value));
+    r.id = set.empty() ? name : safe_name(name + "_" + sweep.param + "_" + number_text(value));
     if (!set.empty()) {
       r.sweep_param = sweep.param;
       r.sweep_value = value;
@@ -341,7 +333,7 @@ void report_scene(Context& c, const ReportScene& scene, int index, int count) {
     const bool input = level.spp == sc.spp;
     std::string label = "noisy " + std::to_string(level.spp) + " spp";
     if (input) label += " (input)";
-    else if (sc.spp > 0) label += " (" + value_text(std::round(100.0 * level.spp / sc.spp) / 100) + "x)";
+    else if (sc.spp > 0) label += " (" + number_text(std::round(100.0 * level.spp / sc.spp) / 100) + "x)";
     levels.push_back({{"label", label}, {"spp", level.spp}, {"is_input", input}, {"relmse", num(sco.mean.relmse)},
                       {"psnr", num(sco.mean.psnr)}, {"ssim", num(sco.mean.ssim)},
                       {"temporal_error", nonneg(sco.temporal_error)}, {"per_frame", per_frame_json(sc, sco)}});
@@ -364,7 +356,7 @@ void report_scene(Context& c, const ReportScene& scene, int index, int count) {
     RunResult r = run_peer(s, p, c.timing);
     ++c.runs;
     if (!r.ok()) ++c.failed;
-    c.log(sc.id + " peer " + p.name + (r.ok() ? ": " + value_text(r.seconds) + " s, relMSE " + value_text(r.scores.mean.relmse)
+    c.log(sc.id + " peer " + p.name + (r.ok() ? ": " + number_text(r.seconds) + " s, relMSE " + number_text(r.scores.mean.relmse)
                                               : ": FAILED: " + r.error));
     runs.push_back(std::move(r));
   }
@@ -435,9 +427,9 @@ json scaling_section(Context& c, const std::vector<ReportScene>& scenes) {
       rows.push_back({{"filter", r.filter}, {"input", r.input}, {"width", r.width}, {"height", r.height},
                       {"pixels", double(r.width) * r.height}, {"seconds", r.seconds},
                       {"peak_memory_mb", nonneg(r.peak_memory_mb)}});
-      c.csv.push_back({"scaling", source_names[kind], "", "", kind, r.filter, "", "true", value_text(r.seconds), "",
-                       r.peak_memory_mb >= 0 ? value_text(r.peak_memory_mb) : "", "", "", "", "", "",
-                       std::to_string(r.width), std::to_string(r.height), value_text(double(r.width) * r.height),
+      c.csv.push_back({"scaling", source_names[kind], "", "", kind, r.filter, "", "true", number_text(r.seconds), "",
+                       r.peak_memory_mb >= 0 ? number_text(r.peak_memory_mb) : "", "", "", "", "", "",
+                       std::to_string(r.width), std::to_string(r.height), number_text(double(r.width) * r.height),
                        "in-process", std::to_string(c.threads), c.cpu});
     }
     for (const auto& level : by_spp[kind]) {
@@ -477,11 +469,6 @@ void remove_stale_work_dirs(const fs::path& out) {
     const long pid = std::strtol(name.c_str() + 6, nullptr, 10);
     if (pid > 0 && ::kill(pid_t(pid), 0) != 0 && errno == ESRCH) fs::remove_all(e.path(), ec);
   }
-}
-
-void check_image_header(const std::string& path) {
-  auto in = OIIO::ImageInput::open(path);
-  if (!in) throw Error(Errc::NotAnImage, "'" + path + "' is not an image OpenImageIO can read: " + OIIO::geterror());
 }
 
 std::string csv_line(const std::vector<std::string>& cells) {
@@ -530,8 +517,14 @@ ReportSummary run_report(const ReportOptions& o) {
     scenes.push_back(user_report_scene(in.name, in.noisy, in.reference, in.frames, in.spp));
     // Every file opens as an image before any work: a bad reference is found now, not after the
     // sample scenes ran.
-    for (const auto* list : {&scenes.back().noisy, &scenes.back().reference})
-      for (const std::string& path : *list) check_image_header(path);
+    for (const auto& [flag, list] : {std::pair{"--input", &scenes.back().noisy}, std::pair{"--reference", &scenes.back().reference}})
+      for (const std::string& path : *list) {
+        try {
+          check_image_file(path);
+        } catch (const Error& e) {
+          throw Error(e.code(), std::string(flag) + ": " + e.what());
+        }
+      }
   }
   if (o.with_samples) {
     const std::string dir = o.samples.empty() ? default_samples_dir() : o.samples;

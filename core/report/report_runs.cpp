@@ -1,9 +1,9 @@
 #include "report/report_runs.h"
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <filesystem>
-#include <fstream>
 #include <regex>
 #include <sstream>
 
@@ -144,13 +144,6 @@ void take_notes(const std::string& log, RunResult& r) {
   }
 }
 
-std::string read_all(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 void fail(RunResult& r, const std::string& what, const CommandRun& run, const std::string& log) {
   r.error = what + (run.timed_out ? ": timed out" : ": exit " + std::to_string(run.exit_code)) + "; " + log_tail(log);
 }
@@ -182,7 +175,9 @@ RunResult run_as_command(const LoadedReportScene& s, const std::string& filter, 
   r.filter = filter;
   const ReportScene& sc = s.scene;
   const bool sequence = !sc.frames_text.empty();
-  const std::string tag = filter + (set.empty() ? "" : "_" + std::to_string(std::hash<std::string>{}(set) % 100000));
+  std::string tag = filter + (set.empty() ? "" : "_" + set);  // one file name per setting
+  for (char& ch : tag)
+    if (!std::isalnum(static_cast<unsigned char>(ch)) && ch != '.' && ch != '_') ch = '_';
   const std::string out = (fs::path(timing.work_dir) / (sc.id + "_" + tag + (sequence ? "_####.exr" : ".exr"))).string();
   // --verbose: the timings and the filter's notes (auto's choice among them).
   std::vector<std::string> argv = {timing.cli, "denoise", "-f", filter, "--verbose", "-j", std::to_string(timing.nthreads)};
@@ -198,7 +193,7 @@ RunResult run_as_command(const LoadedReportScene& s, const std::string& filter, 
   }
   r.seconds = run.seconds;
   r.peak_memory_mb = run.peak_memory_mb;
-  const std::string text = read_all(log);
+  const std::string text = read_log(log);
   const double ms = parse_filter_ms(text);
   r.filter_seconds = ms >= 0 ? ms / 1000.0 : -1;
   take_notes(text, r);

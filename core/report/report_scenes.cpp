@@ -170,9 +170,6 @@ ReportScene user_report_scene(const std::string& name, const std::string& noisy,
     r.noisy.push_back(sequence ? sequence_path(noisy, f) : noisy);
     r.reference.push_back(sequence ? sequence_path(reference, f) : reference);
     r.deep.push_back(r.noisy.back());  // a deep file serves the deep filters too
-    for (const auto& [flag, path] : {std::pair{"--input", r.noisy.back()}, std::pair{"--reference", r.reference.back()}})
-      if (!fs::is_regular_file(path))
-        throw Error(Errc::FileNotFound, std::string(flag) + " '" + path + "': no such file");
   }
   if (spp > 0) r.levels.push_back({spp, r.noisy, r.deep});
   return r;

@@ -37,7 +37,8 @@ std::vector<ReportScene> sample_report_scenes(const std::string& dir, const std:
                                               const std::vector<std::string>& only = {});
 
 // A user's render: `noisy` and `reference` files, or #### patterns with `frames` ("1-16").
-// Throws FileNotFound naming the flag and the path.
+// Throws InvalidArgument for a pattern without frames or frames without a pattern; the files
+// themselves are checked by the caller (io/frame_reader.h, check_image_file).
 ReportScene user_report_scene(const std::string& name, const std::string& noisy, const std::string& reference,
                               const std::string& frames, int spp);
 

@@ -97,17 +97,9 @@ std::shared_ptr<const LightField> tile_lightfield(const LightField& src, int wid
 }  // namespace
 
 Frame mirrored_tiling(const Frame& src, int width, int height) {
-  Frame out;
-  out.width = width;
-  out.height = height;
-  out.path = src.path + " (tiled to " + std::to_string(width) + "x" + std::to_string(height) + ")";
-  out.layer = src.layer;
-  out.layers = src.layers;
-  for (const Pass& p : src.passes) {
-    Pass q = p;
-    q.image = tile_image(p.image, width, height);
-    out.passes.push_back(std::move(q));
-  }
+  Frame out = src.header(width, height);
+  out.path += " (tiled to " + std::to_string(width) + "x" + std::to_string(height) + ")";
+  for (const Pass& p : src.passes) out.passes.push_back(with_pixels(p, tile_image(p.image, width, height)));
   if (src.lightfield) {
     // The light-field filters read the decoded light field; the deep buffer only says what the
     // file was (its attributes), so it is not copied sample by sample.
