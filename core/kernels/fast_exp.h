@@ -1,9 +1,8 @@
 #pragma once
-// The kernels' exponentials, both written here: exp_neg_v, the W-lane float exp(-e) of the
-// edge-avoiding kernels (GCC vector extensions; cross_bilateral.cpp with its block and
-// symmetric headers, and feature_regression.cpp, only inside always-inlined code of
-// functions compiled for one instruction set), and exp_neg_d, the double one of pwaf's
-// weights (the float one's 2e-7 would show in pwaf's sums of up to 65^2 weights).
+// The kernels' exponential, written here: exp_neg_v, the W-lane float exp(-e) of the
+// edge-avoiding kernels and of pwaf's windows (GCC vector extensions; cross_bilateral.cpp
+// with its block and symmetric headers, feature_regression.cpp and pwaf_window.cpp, only
+// inside always-inlined code of functions compiled for one instruction set).
 #include <cstdint>
 #include <cstring>
 
@@ -50,30 +49,4 @@ MCR_INLINE typename Vec<W>::f exp_neg_v(typename Vec<W>::f e) {
 }
 
 }  // namespace simd
-// exp(-d), d in [0, 40], double precision.
-// exp(-d) for d in [0, 40]: 2^-(d log2 e) split into 2^n (exponent bits) times 2^f,
-// |f| <= 1/2, with e^(f ln 2) by its Taylor series to degree 11 (relative error < 1e-14).
-// Several times faster than std::exp and the same on every machine.
-inline double exp_neg_d(double d) {
-  const double t = -d * 1.4426950408889634;  // log2(e)
-  const double n = -double(std::int64_t(0.5 - t));  // round half up, t <= 0
-  const double x = (t - n) * 0.6931471805599453;  // ln 2, |x| <= 0.347
-  double p = 1.0 / 39916800.0;
-  p = p * x + 1.0 / 3628800.0;
-  p = p * x + 1.0 / 362880.0;
-  p = p * x + 1.0 / 40320.0;
-  p = p * x + 1.0 / 5040.0;
-  p = p * x + 1.0 / 720.0;
-  p = p * x + 1.0 / 120.0;
-  p = p * x + 1.0 / 24.0;
-  p = p * x + 1.0 / 6.0;
-  p = p * x + 0.5;
-  p = p * x + 1.0;
-  p = p * x + 1.0;
-  const std::int64_t bits = (std::int64_t(n) + 1023) << 52;  // n in [-58, 0]: a normal double
-  double scale;
-  std::memcpy(&scale, &bits, sizeof scale);
-  return p * scale;
-}
-
 }  // namespace mcr

@@ -359,6 +359,47 @@ TEST(PwafFilterTest, FeatureWeightsOffAndFixedWindowIsAGaussianWeightedMean) {
     }
 }
 
+// The vectorised window (kernels/pwaf_window.h) against eq. 8 written out in double: Gp, Gn
+// and Gsn on random normals (one NaN: that pixel's Gn is off in every pair it is part of),
+// colour weight off, fixed windows, on a frame whose width is not a multiple of any lane count.
+TEST(PwafFilterTest, FeatureWeightsMatchEquation8WrittenOut) {
+  const int w = 23, h = 13, r = 4;
+  const double sp = 2.1, sn = 0.6, ssn = 0.9;
+  Frame f = frame_of(random_image(w, h, 61, 0.1f, 0.9f));
+  Image n1 = random_image(w, h, 62, -1.0f, 1.0f), n2 = random_image(w, h, 63, -1.0f, 1.0f);
+  n1.at(9, 6, 1) = kNaN;
+  f.passes.push_back(named_pass(Role::Normal, "Normal", n1));
+  f.passes.push_back(named_pass(Role::SecondNormal, "second_normal", n2));
+  const PwafRun run = run_pwaf(f, {{"adaptive", false},
+                                   {"max_radius", std::int64_t(r)},
+                                   {"sigma_p", sp},
+                                   {"sigma_c", 1e6},
+                                   {"sigma_n", sn},
+                                   {"sigma_sn", ssn},
+                                   {"outlier_k", 0.0}});
+  const Image& in = f.image(Role::Colour);
+  auto d2 = [](const Image& im, int x0, int y0, int x1, int y1) {
+    double s = 0;
+    for (int c = 0; c < 3; ++c) s += std::pow(double(im.at(x0, y0, c)) - double(im.at(x1, y1, c)), 2);
+    return s;
+  };
+  auto finite = [&](int x, int y) { return std::isfinite(n1.at(x, y, 0) + n1.at(x, y, 1) + n1.at(x, y, 2)); };
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      double s[3] = {0, 0, 0}, sw = 0;
+      for (int yy = std::max(0, y - r); yy <= std::min(h - 1, y + r); ++yy)
+        for (int xx = std::max(0, x - r); xx <= std::min(w - 1, x + r); ++xx) {
+          double e = 0.5 * ((xx - x) * (xx - x) + (yy - y) * (yy - y)) / (sp * sp);
+          if (finite(x, y) && finite(xx, yy)) e += d2(n1, x, y, xx, yy) / (2 * sn * sn);
+          e += d2(n2, x, y, xx, yy) / (2 * ssn * ssn);
+          const double g = std::exp(-e);
+          for (int c = 0; c < 3; ++c) s[c] += g * in.at(xx, yy, c);
+          sw += g;
+        }
+      for (int c = 0; c < 3; ++c) ASSERT_NEAR(run.out.at(x, y, c), s[c] / sw, 2e-6) << x << "," << y << " c" << c;
+    }
+}
+
 TEST(PwafFilterTest, NormalEdgeIsPreserved) {
   // Two flat colours meeting where the normal turns by 90 degrees; the colour kernel is off,
   // so only Gn can keep them apart.

@@ -1,18 +1,18 @@
 #include "filters/image/pwaf.h"
 
 #include <algorithm>
+#include <cfloat>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <limits>
 #include <string>
-#include <type_traits>
 
 #include "image/luminance.h"
-#include "kernels/fast_exp.h"
 #include "kernels/feature_activity.h"
 #include "kernels/noise_variance.h"
+#include "kernels/planes.h"
+#include "kernels/pwaf_window.h"
 #include "prepare/outliers.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -83,10 +83,6 @@ Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing) {
 }
 
 
-inline double dist2(const float* a, const float* b) {
-  const double d0 = double(a[0]) - double(b[0]), d1 = double(a[1]) - double(b[1]), d2 = double(a[2]) - double(b[2]);
-  return d0 * d0 + d1 * d1 + d2 * d2;
-}
 
 }  // namespace
 
@@ -149,8 +145,9 @@ const FilterInfo& PwafFilter::static_info() {
         "colour pixels with a NaN/Inf channel are replaced by the mean of the finite pixels of their outlier window "
         "(left out of every window and output 0 only when that window has none); a non-finite feature value switches "
         "that feature's Gaussian off (factor 1) for every pair that involves the pixel; a non-finite or negative "
-        "variance-pass value is ignored (the estimate is used where none is left); all arithmetic is in double and "
-        "outputs are clamped to the float range, so no NaN/Inf is ever produced";
+        "variance-pass value is ignored (the estimate is used where none is left); the colour is scaled by a power "
+        "of two into a range where no float sum overflows, weights are relative to each window's largest (a window "
+        "never sums to 0 by underflow) and outputs are clamped to the float range, so no NaN/Inf is ever produced";
     return i;
   }();
   return info;
@@ -375,112 +372,77 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       inv[nf] = f->inv2s2;
       used[nf++] = f;
     }
-  // Everything the inner loop reads, packed per pixel of the roi grown by max_radius: colour,
-  // then the used features (3 floats each, non-finite ones zeroed); mask bit 0 = valid colour,
-  // bit k+1 = feature k finite.
-  const int stride = 3 + 3 * nf;
-  const int fw = fr.width();
-  std::vector<float> pk(std::size_t(fw) * fr.height() * stride, 0.0f);
-  std::vector<std::uint8_t> mask(std::size_t(fw) * fr.height(), 0);
+  // Everything the kernel reads, as planes over the roi grown by max_radius
+  // (kernels/pwaf_window.h): the colour, scaled by a power of two into a range where no
+  // float sum overflows or turns denormal (exact, undone on output); the range value,
+  // the colour coefficient and the radius of every centre; each used feature with a plane
+  // that says where it is finite. The result is written over the range value's planes.
+  ColourPlanes cp;
+  planar_colour(in, fr, 0.0, nthreads, cp);
+  const PlaneBox& pb = cp.pb;
+  const float scale = cp.scale;
+  PwafWindowPass wp;
+  wp.pb = pb;
+  std::vector<float> valid_plane = pb.plane(), ref[3] = {pb.plane(), pb.plane(), pb.plane()}, a_plane = pb.plane(),
+                     r_plane = pb.plane();
+  std::vector<float> feat[3][3], feat_ok[3];
+  for (int k = 0; k < nf; ++k) {
+    for (auto& f : feat[k]) f = pb.plane();
+    feat_ok[k] = pb.plane();
+  }
   parallel_rows(fr.y0, fr.y1, nthreads, [&](int y) {
     for (int x = fr.x0; x < fr.x1; ++x) {
-      const std::size_t i = std::size_t(y - fr.y0) * fw + (x - fr.x0);
-      float* d = &pk[i * stride];
-      std::copy(in.pixel(x, y), in.pixel(x, y) + 3, d);
-      std::uint8_t m = valid[std::size_t(y) * w + x] ? 1 : 0;
+      const std::size_t j = pb.index(x, y);
+      const bool ok = valid[std::size_t(y) * w + x];
+      valid_plane[j] = ok ? 1.0f : 0.0f;
+      if (!ok)
+        for (auto& c : cp.c) c[j] = 0.0f;
       for (int k = 0; k < nf; ++k) {
         float v[3];
         if (feature_at(*used[k]->image, x, y, v)) {
-          std::copy(v, v + 3, d + 3 + 3 * k);
-          m = std::uint8_t(m | (2 << k));
+          for (int c = 0; c < 3; ++c) feat[k][c][j] = v[c];
+          feat_ok[k][j] = 1.0f;
         }
       }
-      mask[i] = m;
     }
   });
-
-  // Gp exponent per |dx|, |dy|.
-  const int R = max_r;
-  std::vector<double> spatial(std::size_t(R + 1) * (R + 1));
-  for (int dy = 0; dy <= R; ++dy)
-    for (int dx = 0; dx <= R; ++dx) spatial[std::size_t(dy) * (R + 1) + dx] = 0.5 * (dx * dx + dy * dy) / (sigma_p * sigma_p);
-
-  // One pixel: the exponent of every valid neighbour (first pass), then the weights relative
-  // to the largest one (second pass): the same mean, and never 0/0. NF, the number of feature
-  // Gaussians, is a template argument so the feature loop unrolls.
-  auto filter_rows = [&](auto nf_tag) {
-    constexpr int NF = decltype(nf_tag)::value;
-    constexpr std::size_t S = 3 + 3 * NF;  // == stride
-    parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
-      std::vector<double> ex(std::size_t(2 * R + 1) * (2 * R + 1));
-      std::vector<std::size_t> at(ex.size());
-      for (int x = roi.x0; x < roi.x1; ++x) {
-        const std::size_t i = std::size_t(y) * w + x;
-        const int r = radius[i];
-        const float* ip = est.pixel(x, y);
-        const double ic[3] = {ip[0], ip[1], ip[2]};
-        // Gc against the estimated range value, sigma_c(p)^2 = sigma_c^2 v(p) + (1e-3 Y(p))^2 +
-        // 1e-300: the pixel's noise level sets the colour scale (3.3); the floors keep a
-        // noise-free pixel from dividing by zero.
-        const double yl = luminance(ip);
-        const double sc2 = sigma_c * sigma_c * std::min(variance[i], 1e300) + 1e-6 * yl * yl + 1e-300;
-        const double kc = 1.0 / (6.0 * sc2);  // mean over the 3 channels, then 1/(2 sigma^2)
-        const std::size_t ip_k = std::size_t(y - fr.y0) * fw + (x - fr.x0);
-        const float* fp = &pk[ip_k * S];
-        const unsigned mp = mask[ip_k];
-        std::size_t n = 0;
-        double emin = std::numeric_limits<double>::infinity();
-        const int y0 = std::max(0, y - r), y1 = std::min(h - 1, y + r);
-        const int x0 = std::max(0, x - r), x1 = std::min(w - 1, x + r);
-        for (int yy = y0; yy <= y1; ++yy) {
-          const double* sp_row = &spatial[std::size_t(std::abs(yy - y)) * (R + 1)];
-          const std::size_t row = std::size_t(yy - fr.y0) * fw;
-          for (int xx = x0; xx <= x1; ++xx) {
-            const std::size_t j = row + std::size_t(xx - fr.x0);
-            const unsigned mq = mask[j];
-            if (!(mq & 1u)) continue;
-            const float* q = &pk[j * S];
-            const double d0 = double(q[0]) - ic[0], d1 = double(q[1]) - ic[1], d2 = double(q[2]) - ic[2];
-            double e = sp_row[std::abs(xx - x)] + (d0 * d0 + d1 * d1 + d2 * d2) * kc;
-            const unsigned both = mp & mq;
-            for (int k = 0; k < NF; ++k)
-              if (both & (2u << k)) e += dist2(fp + 3 + 3 * k, q + 3 + 3 * k) * inv[k];
-            e = std::min(e, kMaxExponent);
-            ex[n] = e;
-            at[n] = j;
-            ++n;
-            emin = std::min(emin, e);
-          }
-        }
-        float* o = out.pixel(x, y);
-        if (n == 0) {
-          o[0] = o[1] = o[2] = 0.0f;  // no valid pixel in the window
-          continue;
-        }
-        // Weights below e^-40 of the largest change the mean by < 1e-14: skipped.
-        double s0 = 0, s1 = 0, s2 = 0, sw = 0;
-        for (std::size_t k = 0; k < n; ++k) {
-          const double d = ex[k] - emin;
-          if (d > 40.0) continue;
-          const double wgt = exp_neg_d(d);
-          const float* q = &pk[at[k] * S];
-          s0 += wgt * double(q[0]);
-          s1 += wgt * double(q[1]);
-          s2 += wgt * double(q[2]);
-          sw += wgt;
-        }
-        o[0] = float(std::clamp(s0 / sw, -kFloatMax, kFloatMax));
-        o[1] = float(std::clamp(s1 / sw, -kFloatMax, kFloatMax));
-        o[2] = float(std::clamp(s2 / sw, -kFloatMax, kFloatMax));
-      }
-    });
-  };
-  switch (nf) {
-    case 0: filter_rows(std::integral_constant<int, 0>{}); break;
-    case 1: filter_rows(std::integral_constant<int, 1>{}); break;
-    case 2: filter_rows(std::integral_constant<int, 2>{}); break;
-    default: filter_rows(std::integral_constant<int, 3>{}); break;
+  // Gc against the estimated range value, sigma_c(p)^2 = sigma_c^2 v(p) + (1e-3 Y(p))^2 +
+  // 1e-300: the pixel's noise level sets the colour scale (3.3); the floors keep a
+  // noise-free pixel from dividing by zero. Mean over the 3 channels, then 1/(2 sigma^2):
+  // a = sqrt(1 / (6 sigma_c(p)^2)), in the scaled colour's units.
+  parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
+    for (int x = roi.x0; x < roi.x1; ++x) {
+      const std::size_t i = std::size_t(y) * w + x, j = pb.index(x, y);
+      const float* ip = est.pixel(x, y);
+      for (int c = 0; c < 3; ++c) ref[c][j] = ip[c] * scale;
+      const double yl = luminance(ip);
+      const double sc2 = sigma_c * sigma_c * std::min(variance[i], 1e300) + 1e-6 * yl * yl + 1e-300;
+      a_plane[j] = float(std::min(std::sqrt(1.0 / (6.0 * sc2)) / double(scale), double(FLT_MAX)));
+      r_plane[j] = float(radius[i]);
+    }
+  });
+  for (int c = 0; c < 3; ++c) {
+    wp.colour[c] = cp.c[c].data();
+    wp.ref[c] = ref[c].data();
+    wp.out[c] = ref[c].data();
   }
+  wp.valid = valid_plane.data();
+  wp.a = a_plane.data();
+  wp.radius = r_plane.data();
+  wp.features = nf;
+  for (int k = 0; k < nf; ++k) {
+    for (int c = 0; c < 3; ++c) wp.feature[k][c] = feat[k][c].data();
+    wp.feature_ok[k] = feat_ok[k].data();
+    wp.k[k] = float(std::min(inv[k], double(FLT_MAX)));
+  }
+  wp.max_radius = max_r;
+  wp.spatial.resize(std::size_t(max_r + 1) * (max_r + 1));
+  for (int dy = 0; dy <= max_r; ++dy)
+    for (int dx = 0; dx <= max_r; ++dx)
+      wp.spatial[std::size_t(dy) * (max_r + 1) + dx] = float(0.5 * (dx * dx + dy * dy) / (sigma_p * sigma_p));
+  pwaf_window_filter(wp, roi, nthreads);
+  const float* res[3] = {ref[0].data(), ref[1].data(), ref[2].data()};
+  store_colour(res, pb, scale, roi, out, nthreads);
   stats_.ff_ms = ms_since(t_ff);
 }
 
