@@ -44,6 +44,7 @@ struct RawImage {
   std::size_t stride = 0;
   std::shared_ptr<DeepSamples> deep;
   std::shared_ptr<const LightField> lightfield;
+  bool independent_samples = false;  // deep, no alpha, not a light field: the per-sample convention
 };
 
 // Native channel c of pixel px as float.
@@ -118,6 +119,7 @@ void read_deep(ImageInput& in, RawImage& raw, const std::string& path) {
         weight[i] = lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[i]) *
                     lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[i]);
     }
+    raw.independent_samples = !raw.lightfield;
     raw.names = d.channel_names;
     raw.pixels.assign(np * nc, 0.0f);
     for (std::size_t p = 0; p < np; ++p) {
@@ -402,6 +404,10 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
                                        (frame.layer.empty() ? "" : " layer '" + frame.layer + "'") +
                                        " (channel groups: " + list + "); name one with --pass colour=GROUP");
   }
+  // Independent samples carry their own noise estimate: the variance of each pixel's mean
+  // from the two halves of its samples (io/half_buffers.h), unless the file has a variance.
+  if (raw.independent_samples && frame.has(Role::Colour) && !frame.has(Role::Variance))
+    if (auto v = sample_halves_variance(*raw.deep, frame.get(Role::Colour))) frame.put(std::move(*v));
   frame.check_sizes();
   return frame;
 }

@@ -1,6 +1,8 @@
 #include "io/half_buffers.h"
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "util/error.h"
 
@@ -35,6 +37,44 @@ Frame combine_halves(Frame first, const Frame& second) {
     }
   first.put(std::move(var));
   return first;
+}
+
+std::optional<Pass> sample_halves_variance(const DeepSamples& deep, const Pass& colour) {
+  if (colour.channels.size() < 3) return std::nullopt;
+  int ch[3];
+  for (int c = 0; c < 3; ++c) {
+    ch[c] = deep.channel(colour.channels[std::size_t(c)]);
+    if (ch[c] < 0) return std::nullopt;
+  }
+  Pass var;
+  var.role = Role::Variance;
+  var.name = "sample halves";
+  var.source = colour.source;
+  var.channels = {"variance.R", "variance.G", "variance.B"};
+  var.image = Image(deep.width, deep.height, 3);
+  std::vector<float> finite;
+  for (int y = 0; y < deep.height; ++y)
+    for (int x = 0; x < deep.width; ++x) {
+      const std::uint64_t first = deep.first(x, y), n_all = deep.samples(x, y);
+      float* v = var.image.pixel(x, y);
+      for (int c = 0; c < 3; ++c) {
+        finite.clear();
+        const std::vector<float>& s = deep.values[std::size_t(ch[c])];
+        for (std::uint64_t i = first; i < first + n_all; ++i)
+          if (std::isfinite(s[i])) finite.push_back(s[i]);
+        const std::size_t n = finite.size(), n1 = n / 2, n2 = n - n1;
+        if (n1 == 0) {
+          v[c] = std::numeric_limits<float>::quiet_NaN();
+          continue;
+        }
+        double a = 0, b = 0;
+        for (std::size_t i = 0; i < n1; ++i) a += finite[i];
+        for (std::size_t i = n1; i < n; ++i) b += finite[i];
+        const double d = a / double(n1) - b / double(n2);
+        v[c] = float(std::min(d * d * double(n1) * double(n2) / (double(n) * double(n)), 3.0e38));
+      }
+    }
+  return var;
 }
 
 }  // namespace mcr

@@ -67,6 +67,18 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   s.box = box_in.clipped(W, H);
   if (s.box.empty()) return s;
   const Rgb y{colour};
+  const bool use_pass = vpass && vpass->width() == W && vpass->height() == H && vpass->channels() > 0;
+  // The pass' value at a pixel (mean over its channels), or -1 where it is not finite and >= 0.
+  auto pass_at = [&](int x, int yy) {
+    const float* v = vpass->pixel(x, yy);
+    const int vc = std::min(3, vpass->channels());
+    double sum = 0;
+    for (int c = 0; c < vc; ++c) {
+      if (!(std::isfinite(v[c]) && v[c] >= 0.0f)) return -1.0;
+      sum += v[c];
+    }
+    return sum / vc;
+  };
   const std::size_t n = std::size_t(s.box.width()) * std::size_t(s.box.height());
   s.variance.assign(n, 0.0f);
   s.relative.assign(n, 0.0f);
@@ -74,6 +86,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   s.finite.assign(n, 0);
   s.outlier.assign(n, 0);
   s.excess.assign(n, 0.0f);
+  s.detail.assign(n, 0);
 
   // Region T: the tiles' windows. Medians and residual energies are needed there.
   const Roi T = s.box.grown(kTileGrow + kTile, W, H);
@@ -155,6 +168,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   // window of every pixel near it (the step back and auto treat it by itself).
   const Roi E = s.box.grown(kVarianceRadius + 1, W, H);
   std::vector<float> exc(std::size_t(E.width()) * std::size_t(E.height()), 0.0f);
+  std::vector<float> dist2(use_pass ? exc.size() : 0, 0.0f);  // mean over R, G, B of the distance^2 itself
   auto tile_of = [&](int x, int yy) {
     const int tx = std::min(std::max((x - s.box.x0) / kTile, 0), ntx - 1);
     const int ty = std::min(std::max((yy - s.box.y0) / kTile, 0), nty - 1);
@@ -179,14 +193,16 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
           any = true;
         }
       const double rel = tile_of(x, yy);
-      double dev = 0;
+      double dev = 0, d2 = 0;
       for (int c = 0; c < 3; ++c) {
         const double m = med[i * 3 + std::size_t(c)];
         const double robust = std::min(std::max(rel * (m * m + kRelativeEps), kFloorRelative * kFloorRelative * m * m), 3.0e38);
         const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
         dev += out * out / std::max(robust, 1e-30);
+        d2 += out * out;
       }
       exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] = float(std::min(dev / 3.0, 3.0e38));
+      if (use_pass) dist2[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] = float(std::min(d2 / 3.0, 3.0e38));
     }
   });
   // Where outliers are many (a 1-spp render lit by rare paths), they are the noise itself and
@@ -227,22 +243,27 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   // Along the axes only: at a corner where four blocks meet, a diagonal has a different
   // value on each side and would count the corner as noise; an axis never does.
   static const int dirs[2][2] = {{1, 0}, {0, 1}};
-  const bool use_pass = vpass && vpass->width() == W && vpass->height() == H && vpass->channels() > 0;
+  // With a pass, the window averages relative variances, each pixel's divided by its own
+  // level L = max(median^2, y^2 - own variance) + 0.01 (relMSE's weight, with y^2 - own an
+  // unbiased estimate of the clean value^2, floored by the 3x3 median^2 where a firefly makes
+  // it small), and the mean is scaled back to the pixel's level: a pass holds each pixel's own
+  // variance, which grows with its value, so an absolute mean carried a bright pixel's
+  // variance onto its dark neighbours (per-sample dof_spheres: the input's relMSE estimated
+  // at 0.99 against a true 0.025), and the median alone misses thin bright structure. Without
+  // a pass the estimate stays absolute (its terms are products of neighbour differences, not
+  // one pixel's variance).
+  auto level = [&](int x, int yy) {
+    if (!use_pass) return 1.0;
+    const double med2 = luminance2(&med[(std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0)) * 3]);
+    const double own = pass_at(x, yy);
+    const double y2 = ok(x, yy) ? luminance2(y.at(x, yy)) : 0.0;
+    return std::max(med2, own >= 0 ? y2 - own : 0.0) + kRelMseEps;
+  };
   parallel_rows(V.y0, V.y1, nthreads, [&](int yy) {
     for (int x = V.x0; x < V.x1; ++x) {
-      if (use_pass) {
-        const float* v = vpass->pixel(x, yy);
-        const int vc = std::min(3, vpass->channels());
-        double sum = 0;
-        bool good = true;
-        for (int c = 0; c < vc; ++c) {
-          good = good && std::isfinite(v[c]) && v[c] >= 0.0f;
-          sum += v[c];
-        }
-        if (good) {
-          z.set(x - V.x0, yy - V.y0, sum / vc, 1.0);
-          continue;
-        }
+      if (const double own = use_pass ? pass_at(x, yy) : -1.0; own >= 0) {
+        z.set(x - V.x0, yy - V.y0, own / level(x, yy), 1.0);
+        continue;
       }
       if (!calm(x, yy)) continue;
       const float* p = y.at(x, yy);
@@ -256,7 +277,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
         for (int c = 0; c < 3; ++c) sum += (double(p[c]) - a[c]) * (double(p[c]) - b[c]);
         ++cnt;
       }
-      if (cnt) z.set(x - V.x0, yy - V.y0, sum / (3.0 * cnt), 1.0);
+      if (cnt) z.set(x - V.x0, yy - V.y0, sum / (3.0 * cnt) / level(x, yy), 1.0);
     }
   });
   z.sum_windows(kVarianceRadius, nthreads);
@@ -271,8 +292,13 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       s.relative[o] = tile_of(x, yy);
       const float e = exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
       s.excess[o] = e;
-      s.outlier[o] = e > kOutlierSigmas * kOutlierSigmas ? 1 : 0;
-      s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0), 0.0), 3.0e38));
+      s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0) * level(x, yy), 0.0), 3.0e38));
+      if (use_pass) {
+        const double own = pass_at(x, yy);
+        const double d2 = dist2[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
+        s.detail[o] = own >= 0 && d2 > kOutlierSigmas * kOutlierSigmas * own;
+      }
+      s.outlier[o] = e > kOutlierSigmas * kOutlierSigmas && !s.detail[o] ? 1 : 0;
     }
   });
   return s;

@@ -26,9 +26,15 @@
 //   variance(p,c) variance(p) shared among the channels in the same proportion.
 //   excess(p)    mean over R, G, B of the squared distance by which y(p) lies beyond the
 //                range of its 8 finite neighbours, in units of robust(p, c);
+//   detail(p)    only with a variance pass: y(p) lies beyond the range of its 8 neighbours
+//                by more than 4 of its own standard deviations (the pass, mean over R, G,
+//                B): its own samples agree that it stands out, so it is detail (a clean
+//                render's aliasing), not a firefly, whose own samples disagree by about
+//                its distance (one sample F of n: distance ~ F/n, own deviation ~ F/n).
 //   outlier(p)   y(p) lies beyond the range of its 8 finite neighbours by more than 4
-//                robust deviations (mean over R, G, B of the squared excess > 16 robust(p)):
-//                a firefly (or a one-pixel highlight); a block's corner is not one.
+//                robust deviations (mean over R, G, B of the squared excess > 16 robust(p)),
+//                and is not detail(p): a firefly (or a one-pixel highlight); a block's
+//                corner is not one.
 //
 // Non-finite pixels take no part in any neighbourhood; at a non-finite pixel every scale
 // is 0 and outlier is false. Deterministic: no reduction depends on the thread count.
@@ -46,7 +52,8 @@ struct NoiseScales {
   std::vector<float> median;        // three per pixel (RGB)
   std::vector<std::uint8_t> finite; // the pixel's RGB is finite
   std::vector<float> excess;        // mean over R, G, B of (distance beyond the neighbours' range)^2 / robust
-  std::vector<std::uint8_t> outlier; // excess > kOutlierSigmas^2
+  std::vector<std::uint8_t> detail;  // a variance pass says it stands out in its own samples
+  std::vector<std::uint8_t> outlier; // excess > kOutlierSigmas^2 and not detail
   std::size_t at(int x, int y) const {
     return std::size_t(y - box.y0) * std::size_t(box.width()) + std::size_t(x - box.x0);
   }
@@ -56,12 +63,14 @@ struct NoiseScales {
 };
 
 constexpr double kOutlierSigmas = 4.0;  // outlier: further than this many robust deviations
+constexpr double kRelMseEps = 0.01;     // relMSE's denominator term, (x - r)^2 / (r^2 + 0.01)
 
 // Scales for the pixels of `box` (clipped to the image); reads up to 12 pixels around it.
 // colour: RGB in its first three channels. variance: a variance pass (the variance of each
 // pixel's value: a renderer's, or (A - B)^2 / 4 from two half buffers), or null; where it
-// is given, finite and >= 0, `variance` is its mean over the channels and the same window
-// instead of the estimate from the image (exact in expectation, no signal in it).
+// is given, finite and >= 0, `variance` comes from it instead of the estimate from the
+// image (exact in expectation, no signal in it): its mean over the channels, averaged over
+// the same window relative to each pixel's level and scaled back to the pixel's (.cpp).
 NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads, const Image* variance = nullptr);
 
 }  // namespace mcr

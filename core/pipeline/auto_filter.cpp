@@ -19,7 +19,6 @@ constexpr int kMinTiles = 4;
 // A pixel beyond its neighbours' range by this many robust deviations is scored by its
 // distance to the local median: SURE's expectation cannot see that this sample is far out.
 constexpr double kScoreSigmas = 2.0;
-constexpr double kRelMseEps = 0.01;
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
 
 // The frame's passes inside r (a new, smaller frame).
@@ -126,6 +125,13 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   return s;
 }
 
+// Whether pixel i is scored by its distance to the local median: beyond its neighbours'
+// range by kScoreSigmas robust deviations, unless a variance pass says its samples agree
+// (NoiseScales::detail: aliased detail of a clean render, not a firefly).
+bool far_out(const Sample& s, std::size_t i) {
+  return s.noise.excess[i] > kScoreSigmas * kScoreSigmas && !s.noise.detail[i];
+}
+
 // Sums of the risk estimate of one candidate on one sample, relMSE-weighted.
 double risk(const Sample& s, const Image& f, const Image& fp) {
   const Image& y = s.frame.image(Role::Colour);
@@ -137,7 +143,7 @@ double risk(const Sample& s, const Image& f, const Image& fp) {
       for (int c = 0; c < 3; ++c, ++k) {
         if (!s.noise.finite[i]) continue;
         const double w = s.weight[k];
-        if (s.noise.excess[i] > kScoreSigmas * kScoreSigmas) {
+        if (far_out(s, i)) {
           // A firefly: SURE's expectation (the local variance) would not see that this one
           // is far out; score how far the result stays from the local median instead.
           const double e = double(f.at(x, yy, c)) - double(s.noise.median[i * 3 + std::size_t(c)]);
@@ -162,7 +168,7 @@ double input_risk(const Sample& s, std::size_t& count) {
       if (!s.noise.finite[i]) continue;
       const float* y = s.frame.image(Role::Colour).pixel(x, yy);
       for (int c = 0; c < 3; ++c) {
-        const bool far = s.noise.excess[i] > kScoreSigmas * kScoreSigmas;
+        const bool far = far_out(s, i);
         const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
         sum += (far ? e * e : s.noise.variance_of(i, c)) * s.weight[k + std::size_t(c)];
       }

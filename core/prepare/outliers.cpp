@@ -63,7 +63,8 @@ bool bright_outlier(double yp, const WindowStats& s, double k) {
 
 }  // namespace
 
-std::size_t clamp_fireflies(Image& colour, int radius, double k, const Roi& roi, int nthreads) {
+std::size_t clamp_fireflies(Image& colour, int radius, double k, const Roi& roi, int nthreads,
+                            const std::vector<std::uint8_t>* keep) {
   const int w = colour.width(), h = colour.height();
   if (!(k > 0) || roi.empty()) return 0;
   const LuminancePlane lum(colour, roi.grown(radius, w, h), nthreads);
@@ -72,6 +73,7 @@ std::size_t clamp_fireflies(Image& colour, int radius, double k, const Roi& roi,
     for (int x = roi.x0; x < roi.x1; ++x) {
       const double yp = lum.at(x, y);
       if (!(yp > 0)) continue;  // NaN, zero or negative: nothing to clamp
+      if (keep && (*keep)[std::size_t(y) * std::size_t(w) + std::size_t(x)]) continue;
       WindowStats s = window_sum(lum, x, y, radius, w, h);
       if (s.n < 3) continue;
       window_moments(lum, x, y, s);

@@ -24,8 +24,10 @@
 namespace mcr {
 
 // In place on the RGB `colour`, pixels inside roi only (the windows read around it).
-// Returns the number of pixels clamped. k <= 0: nothing.
-std::size_t clamp_fireflies(Image& colour, int radius, double k, const Roi& roi, int nthreads);
+// Returns the number of pixels clamped. k <= 0: nothing. keep: optional, one per pixel of
+// the image; a pixel with keep 1 is never clamped (detail by a variance pass).
+std::size_t clamp_fireflies(Image& colour, int radius, double k, const Roi& roi, int nthreads,
+                            const std::vector<std::uint8_t>* keep = nullptr);
 
 // Inside roi (pixels outside are copied from colour). A non-finite pixel with no finite
 // neighbour is set to 0 and marked invalid (valid[i] = 0); every other pixel is valid.

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/noise_scale.h"
 #include "prepare/albedo_prefilter.h"
 #include "prepare/demodulation.h"
 #include "prepare/outliers.h"
@@ -193,6 +194,16 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   }
   out.colour = rgb_copy(out.frame->image(Role::Colour), nthreads);
   if (work.empty()) return;
+  // With a variance pass, a pixel whose own samples agree as well as its neighbours' is detail
+  // however bright (kernels/noise_scale.h, NoiseScales::detail): never clamped as a firefly.
+  std::vector<std::uint8_t> detail;
+  if (fireflies)
+    if (const Pass* v = out.frame->find(Role::Variance)) {
+      const NoiseScales ns = estimate_noise_scales(out.colour, demod_region, nthreads, &v->image);
+      detail.assign(std::size_t(w) * std::size_t(h), 0);
+      for (int y = ns.box.y0; y < ns.box.y1; ++y)
+        for (int x = ns.box.x0; x < ns.box.x1; ++x) detail[std::size_t(y) * std::size_t(w) + std::size_t(x)] = ns.detail[ns.at(x, y)];
+    }
 
   // Albedo demodulation: filter the illumination, not the texture.
   if (steps.demodulate && params.get_bool("demodulate")) {
@@ -210,7 +221,8 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   // outlier, and a firefly stands out of its window more clearly (glossy: 0.0099 -> 0.0090).
   if (fireflies) {
     const std::size_t clamped = clamp_fireflies(out.colour, int(params.get_int("firefly_radius")),
-                                                params.get_float("firefly_k"), work, nthreads);
+                                                params.get_float("firefly_k"), work, nthreads,
+                                                detail.empty() ? nullptr : &detail);
     if (clamped) out.notes.push_back("firefly suppression clamped " + std::to_string(clamped) + " pixels");
   }
   if (steps.outliers) clamp_channels(out.colour, params.get_float("clamp"), work, nthreads);

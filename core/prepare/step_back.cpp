@@ -12,7 +12,6 @@ namespace mcr {
 
 namespace {
 
-constexpr double kRelMseEps = 0.01;     // relMSE's denominator term
 constexpr double kRangeSigmas = 2.0;    // how far the blend may leave the 3x3 input range
 constexpr float kMax = 3.402823466e38f;
 

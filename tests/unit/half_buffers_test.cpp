@@ -1,12 +1,16 @@
 // io/half_buffers: the mean and the variance pass of two half buffers, against known noise
 // and against the sample renders' halves, their 16-spp file and their reference.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <limits>
 #include <random>
 
 #include "feature_filter_testutil.h"
+#include "io/deep_writer.h"
 #include "io/frame_reader.h"
 #include "io/half_buffers.h"
 #include "io/sample_manifest.h"
@@ -97,6 +101,56 @@ TEST(HalfBuffers, SampleHalvesGiveThe16SppRenderAndItsNoise) {
     }
   }
   EXPECT_GE(checked, 3);
+}
+
+// A per-sample deep file (no alpha) read as a flat frame carries the variance of each
+// pixel's mean from the halves of its samples in stored order: (A - B)^2 n1 n2 / n^2, with
+// n1 = n / 2. Non-finite samples are left out; under two finite samples, NaN. A file with
+// alpha (compositing layers, not independent samples) gets none.
+TEST(HalfBuffers, APerSampleFileCarriesTheVarianceOfItsHalves) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  // R of each pixel's samples; G = 2 R, B = R + 1 (the same variance as R, four times for G).
+  const std::vector<std::vector<float>> r = {{1, 1, 3, 3}, {0, 2, 5}, {7}, {4, nan, 6}, {2, 2}, {1, 2, 3, 4, 5, 6}};
+  const double want[] = {4.0 * 2 * 2 / 16, 3.5 * 3.5 * 1 * 2 / 9, -1, 4.0 * 1 * 1 / 4, 0.0, 9.0 * 3 * 3 / 36};
+  DeepSamples d;
+  d.width = 3;
+  d.height = 2;
+  d.channel_names = {"R", "G", "B", "Z"};
+  d.offsets = {0};
+  d.values.assign(4, {});
+  for (const auto& px : r) {
+    for (float v : px) {
+      d.values[0].push_back(v);
+      d.values[1].push_back(2 * v);
+      d.values[2].push_back(v + 1);
+      d.values[3].push_back(5.0f);
+    }
+    d.offsets.push_back(d.offsets.back() + px.size());
+  }
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("mcrecon_halves_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / "samples.exr").string();
+  write_deep_samples(d, path);
+  const Frame f = read_frame(path);
+  const Pass* var = f.find(Role::Variance);
+  ASSERT_NE(var, nullptr);
+  for (int i = 0; i < 6; ++i) {
+    const int x = i % 3, y = i / 3;
+    if (want[i] < 0) {
+      for (int c = 0; c < 3; ++c) EXPECT_TRUE(std::isnan(var->image.at(x, y, c))) << i;
+      continue;
+    }
+    EXPECT_NEAR(var->image.at(x, y, 0), want[i], 1e-5 * (1 + want[i])) << i;
+    EXPECT_NEAR(var->image.at(x, y, 1), 4 * want[i], 1e-5 * (1 + want[i])) << i;
+    EXPECT_NEAR(var->image.at(x, y, 2), want[i], 1e-5 * (1 + want[i])) << i;
+  }
+  // With alpha: compositing layers, no variance pass.
+  d.channel_names = {"R", "G", "B", "A"};
+  for (float& a : d.values[3]) a = 0.5f;
+  write_deep_samples(d, path);
+  EXPECT_EQ(read_frame(path).find(Role::Variance), nullptr);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

@@ -91,21 +91,76 @@ TEST(NoiseScale, FireflyIsAnOutlierAndDoesNotInflateTheRobustScale) {
 TEST(NoiseScale, AVariancePassIsUsedWhereItIsValid) {
   const int w = 64, h = 48;
   std::mt19937 rng(9);
-  std::normal_distribution<float> noise(0.0f, 0.05f);
-  Image im(w, h, 3), var(w, h, 1, 0.05f * 0.05f);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  // Noise that grows with the value, as Monte Carlo noise does, and a pass that says so.
+  Image im(w, h, 3), var(w, h, 1);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x)
-      for (int c = 0; c < 3; ++c) im.at(x, y, c) = ((x + y) % 2 ? 1.0f : 0.3f) + noise(rng);
+    for (int x = 0; x < w; ++x) {
+      const float v = (x + y) % 2 ? 1.0f : 0.3f, sd = 0.05f * v;
+      var.at(x, y, 0) = sd * sd;
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) = v + sd * noise(rng);
+    }
   const NoiseScales without = estimate_noise_scales(im, Roi::all(w, h), 1);
   EXPECT_GT(mean_over(without.variance), 10 * 0.05 * 0.05);
+  // The checkerboard's signal is not in it: every pixel within 1.5x of its own variance
+  // (inside the frame: at a corner the 3x3 median of 2 + 2 pixels, a level floor, is the
+  // bright one's, and a dark corner pixel reads 3.8x).
   const NoiseScales with = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
-  EXPECT_NEAR(mean_over(with.variance), 0.05 * 0.05, 1e-6);
+  for (int y = 1; y < h - 1; ++y)
+    for (int x = 1; x < w - 1; ++x) {
+      const double want = var.at(x, y, 0), got = with.variance[with.at(x, y)];
+      ASSERT_GT(got, want / 1.5) << x << "," << y;
+      ASSERT_LT(got, want * 1.5) << x << "," << y;
+    }
   // Invalid pass values fall back to the estimate there.
   for (int x = 0; x < w; ++x)
     for (int y = 0; y < 16; ++y) var.at(x, y, 0) = -1.0f;
   const NoiseScales part = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
   EXPECT_GT(part.variance[part.at(30, 2)], 10 * 0.05 * 0.05);
-  EXPECT_NEAR(part.variance[part.at(30, 40)], 0.05 * 0.05, 1e-6);
+  EXPECT_NEAR(part.variance[part.at(30, 40)], with.variance[with.at(30, 40)], 1e-9);
+}
+
+// Monte Carlo variance grows with the value: a pass proportional to each pixel's level
+// (here 1% of value^2 + 0.01, on a bright region beside a dark one) comes back exactly at
+// every pixel, also beside the edge, where an absolute window mean gave the dark pixels
+// the bright ones' variance.
+TEST(NoiseScale, AVariancePassIsAveragedRelativeToEachPixelsLevel) {
+  const int w = 40, h = 24;
+  Image im(w, h, 3), var(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const float v = x < w / 2 ? 4.0f : 0.1f;
+      for (int c = 0; c < 3; ++c) {
+        im.at(x, y, c) = v;
+        var.at(x, y, c) = 0.01f * (v * v + 0.01f);
+      }
+    }
+  const NoiseScales s = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x) {
+      const double want = var.at(x, y, 0);
+      ASSERT_NEAR(s.variance[s.at(x, y)], want, 1e-4 * want) << x << "," << y;
+    }
+}
+
+// With a pass, a pixel far beyond its neighbours is an outlier only when its own variance
+// explains the distance (a firefly: one sample of many, its halves differ by about its
+// distance); one whose own samples agree is detail (a clean render's aliasing).
+TEST(NoiseScale, APassTellsDetailFromAFirefly) {
+  const int w = 24, h = 24;
+  Image im(w, h, 3, 0.2f), var(w, h, 3, 1e-6f);
+  for (int c = 0; c < 3; ++c) im.at(12, 12, c) = 2.0f;
+  const NoiseScales detail = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
+  const std::size_t i = detail.at(12, 12);
+  EXPECT_GT(detail.excess[i], kOutlierSigmas * kOutlierSigmas);  // far out by the distance alone
+  EXPECT_EQ(detail.detail[i], 1);
+  EXPECT_EQ(detail.outlier[i], 0);
+  for (int c = 0; c < 3; ++c) var.at(12, 12, c) = 1.8f * 1.8f;  // its own samples disagree by its distance
+  const NoiseScales firefly = estimate_noise_scales(im, Roi::all(w, h), 1, &var);
+  EXPECT_EQ(firefly.detail[i], 0);
+  EXPECT_EQ(firefly.outlier[i], 1);
+  // Without a pass the distance alone decides.
+  EXPECT_EQ(estimate_noise_scales(im, Roi::all(w, h), 1).outlier[i], 1);
 }
 
 TEST(NoiseScale, NonFinitePixelsTakeNoPart) {
