@@ -40,15 +40,13 @@ MCR_INLINE void window_block(const PwafWindowPass& a, int y, int x, int lanes, s
   const std::size_t crow = std::size_t(y) * stride + kPlanePad + std::size_t(x);
   const vf inf = splat<W>(__builtin_inff());
 
-  vf ref[3], own[3], fp[NF > 0 ? NF : 1][3], fok[NF > 0 ? NF : 1];
+  vf ref[3], own[3], fp[NF > 0 ? NF : 1][3];
   for (int c = 0; c < 3; ++c) {
     ref[c] = ld<W>(a.ref[c] + crow);
     own[c] = ld<W>(a.colour[c] + crow);
   }
-  for (int k = 0; k < NF; ++k) {
+  for (int k = 0; k < NF; ++k)
     for (int c = 0; c < 3; ++c) fp[k][c] = ld<W>(a.feature[k][c] + crow);
-    fok[k] = ld<W>(a.feature_ok[k] + crow);
-  }
   const vf av = ld<W>(a.a + crow);
   vf r = ld<W>(a.radius + crow);
   float rmax = 0.0f;
@@ -83,9 +81,9 @@ MCR_INLINE void window_block(const PwafWindowPass& a, int y, int x, int lanes, s
       const vf u = fp[k][0] - ld<W>(a.feature[k][0] + q), v = fp[k][1] - ld<W>(a.feature[k][1] + q),
                w = fp[k][2] - ld<W>(a.feature[k][2] + q);
       const vf t = (u * u + v * v + w * w) * a.k[k];
-      // Both finite: the term; an equal pair adds 0 even when k * d^2 would be inf * 0.
-      const vi use = (fok[k] * ld<W>(a.feature_ok[k] + q) > 0.0f) & (t > 0.0f);
-      ex = use ? ex + t : ex;
+      // A non-finite value at either pixel is NaN here (t > 0 is false): the term is left out;
+      // an equal pair adds 0 even when k * d^2 would be inf * 0.
+      ex = t > 0.0f ? ex + t : ex;
     }
     ex = ex < splat<W>(FLT_MAX) ? ex : splat<W>(FLT_MAX);  // inf sums stay comparable (all equal: equal weights)
     const vi ok = (ld<W>(a.valid + q) > 0.0f) & (splat<W>(m) <= r);

@@ -27,8 +27,7 @@ struct PwafWindowPass {
   const float* a = nullptr;                       // centre: sqrt of the colour coefficient
   const float* radius = nullptr;                  // centre: window radius (an integer, as float)
   int features = 0;                               // at most 3 three-channel features
-  const float* feature[3][3] = {};                // their planes (0 where not finite)
-  const float* feature_ok[3] = {};                // 1 where finite
+  const float* feature[3][3] = {};                // their planes (NaN where not finite: the pair's term is left out)
   float k[3] = {0, 0, 0};                         // 1 / (2 sigma^2) of each
   int max_radius = 0;
   std::vector<float> spatial;                     // exponent at (|dx|, |dy|): [|dy| * (max_radius + 1) + |dx|]

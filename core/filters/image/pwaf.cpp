@@ -375,8 +375,8 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // Everything the kernel reads, as planes over the roi grown by max_radius
   // (kernels/pwaf_window.h): the colour, scaled by a power of two into a range where no
   // float sum overflows or turns denormal (exact, undone on output); the range value,
-  // the colour coefficient and the radius of every centre; each used feature with a plane
-  // that says where it is finite. The result is written over the range value's planes.
+  // the colour coefficient and the radius of every centre; each used feature (NaN where it is
+  // not finite). The result is written over the range value's planes.
   ColourPlanes cp;
   planar_colour(in, fr, 0.0, nthreads, cp);
   const PlaneBox& pb = cp.pb;
@@ -385,11 +385,9 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   wp.pb = pb;
   std::vector<float> valid_plane = pb.plane(), ref[3] = {pb.plane(), pb.plane(), pb.plane()}, a_plane = pb.plane(),
                      r_plane = pb.plane();
-  std::vector<float> feat[3][3], feat_ok[3];
-  for (int k = 0; k < nf; ++k) {
-    for (auto& f : feat[k]) f = pb.plane();
-    feat_ok[k] = pb.plane();
-  }
+  std::vector<float> feat[3][3];
+  for (int k = 0; k < nf; ++k)
+    for (auto& f : feat[k]) f = pb.plane(std::numeric_limits<float>::quiet_NaN());
   parallel_rows(fr.y0, fr.y1, nthreads, [&](int y) {
     for (int x = fr.x0; x < fr.x1; ++x) {
       const std::size_t j = pb.index(x, y);
@@ -399,10 +397,8 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
         for (auto& c : cp.c) c[j] = 0.0f;
       for (int k = 0; k < nf; ++k) {
         float v[3];
-        if (feature_at(*used[k]->image, x, y, v)) {
+        if (feature_at(*used[k]->image, x, y, v))
           for (int c = 0; c < 3; ++c) feat[k][c][j] = v[c];
-          feat_ok[k][j] = 1.0f;
-        }
       }
     }
   });
@@ -432,7 +428,6 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   wp.features = nf;
   for (int k = 0; k < nf; ++k) {
     for (int c = 0; c < 3; ++c) wp.feature[k][c] = feat[k][c].data();
-    wp.feature_ok[k] = feat_ok[k].data();
     wp.k[k] = float(std::min(inv[k], double(FLT_MAX)));
   }
   wp.max_radius = max_r;
