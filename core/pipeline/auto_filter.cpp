@@ -19,6 +19,7 @@ constexpr int kMinTiles = 4;
 // A pixel beyond its neighbours' range by this many robust deviations is scored by its
 // distance to the local median: SURE's expectation cannot see that this sample is far out.
 constexpr double kScoreSigmas = 2.0;
+constexpr double kDivergenceSlack = 1.0;  // per-pixel divergence kept in [-slack, 1 + slack]
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
 
 // The frame's passes inside r (a new, smaller frame).
@@ -152,7 +153,13 @@ double risk(const Sample& s, const Image& f, const Image& fp) {
         }
         const double v = s.noise.variance_of(i, c);
         const double d = double(f.at(x, yy, c)) - double(y.at(x, yy, c));
-        const double div = double(s.sign_over_eps[k]) * (double(fp.at(x, yy, c)) - double(f.at(x, yy, c)));
+        // The divergence of a filter that averages is its centre weight, in [0, 1]; the probe's
+        // estimate adds the zero-mean cross terms of the neighbours' weights. Far outside that, the
+        // response was not a derivative but a jump (pwaf's radius follows its variance estimate,
+        // which the probe moves): such a pixel says nothing of the slope, so it is cut to the range.
+        const double div = std::clamp(
+            double(s.sign_over_eps[k]) * (double(fp.at(x, yy, c)) - double(f.at(x, yy, c))), -kDivergenceSlack,
+            1.0 + kDivergenceSlack);
         sum += w * (d * d - v + 2.0 * v * div);
       }
     }
