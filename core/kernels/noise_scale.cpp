@@ -49,7 +49,48 @@ float median_of(float* v, int n) {
 
 double luminance2(const float* m) { return (double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0; }
 
+// A variance pass at (x, y): the mean over its (at most 3) channels, or -1 where one is not
+// finite and >= 0.
+double pass_variance(const Image& v, int x, int y) {
+  const float* p = v.pixel(x, y);
+  const int vc = std::min(3, v.channels());
+  double sum = 0;
+  for (int c = 0; c < vc; ++c) {
+    if (!(std::isfinite(p[c]) && p[c] >= 0.0f)) return -1.0;
+    sum += p[c];
+  }
+  return sum / vc;
+}
+
 }  // namespace
+
+bool stands_out_in_own_samples(const Image& colour, const Image& variance, int x, int y) {
+  const Rgb rgb{colour};
+  const double own = pass_variance(variance, x, y);
+  if (own < 0 || !rgb.finite(x, y)) return false;
+  const float* p = rgb.at(x, y);
+  float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
+  bool any = false;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int qx = x + dx, qy = y + dy;
+      if ((!dx && !dy) || qx < 0 || qy < 0 || qx >= colour.width() || qy >= colour.height() || !rgb.finite(qx, qy))
+        continue;
+      const float* q = rgb.at(qx, qy);
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = any ? std::min(lo[c], q[c]) : q[c];
+        hi[c] = any ? std::max(hi[c], q[c]) : q[c];
+      }
+      any = true;
+    }
+  if (!any) return false;
+  double d2 = 0;
+  for (int c = 0; c < 3; ++c) {
+    const double out = double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]);
+    d2 += out * out;
+  }
+  return d2 / 3.0 > kOutlierSigmas * kOutlierSigmas * own;
+}
 
 double NoiseScales::robust(std::size_t i, int c) const {
   const double m = median[i * 3 + std::size_t(c)];
@@ -68,17 +109,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   if (s.box.empty()) return s;
   const Rgb y{colour};
   const bool use_pass = vpass && vpass->width() == W && vpass->height() == H && vpass->channels() > 0;
-  // The pass' value at a pixel (mean over its channels), or -1 where it is not finite and >= 0.
-  auto pass_at = [&](int x, int yy) {
-    const float* v = vpass->pixel(x, yy);
-    const int vc = std::min(3, vpass->channels());
-    double sum = 0;
-    for (int c = 0; c < vc; ++c) {
-      if (!(std::isfinite(v[c]) && v[c] >= 0.0f)) return -1.0;
-      sum += v[c];
-    }
-    return sum / vc;
-  };
+  auto pass_at = [&](int x, int yy) { return pass_variance(*vpass, x, yy); };
   const std::size_t n = std::size_t(s.box.width()) * std::size_t(s.box.height());
   s.variance.assign(n, 0.0f);
   s.relative.assign(n, 0.0f);
@@ -168,7 +199,6 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   // window of every pixel near it (the step back and auto treat it by itself).
   const Roi E = s.box.grown(kVarianceRadius + 1, W, H);
   std::vector<float> exc(std::size_t(E.width()) * std::size_t(E.height()), 0.0f);
-  std::vector<float> dist2(use_pass ? exc.size() : 0, 0.0f);  // mean over R, G, B of the distance^2 itself
   auto tile_of = [&](int x, int yy) {
     const int tx = std::min(std::max((x - s.box.x0) / kTile, 0), ntx - 1);
     const int ty = std::min(std::max((yy - s.box.y0) / kTile, 0), nty - 1);
@@ -193,16 +223,14 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
           any = true;
         }
       const double rel = tile_of(x, yy);
-      double dev = 0, d2 = 0;
+      double dev = 0;
       for (int c = 0; c < 3; ++c) {
         const double m = med[i * 3 + std::size_t(c)];
         const double robust = std::min(std::max(rel * (m * m + kRelativeEps), kFloorRelative * kFloorRelative * m * m), 3.0e38);
         const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
         dev += out * out / std::max(robust, 1e-30);
-        d2 += out * out;
       }
       exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] = float(std::min(dev / 3.0, 3.0e38));
-      if (use_pass) dist2[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] = float(std::min(d2 / 3.0, 3.0e38));
     }
   });
   // Where outliers are many (a 1-spp render lit by rare paths), they are the noise itself and
@@ -293,11 +321,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       const float e = exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
       s.excess[o] = e;
       s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0) * level(x, yy), 0.0), 3.0e38));
-      if (use_pass) {
-        const double own = pass_at(x, yy);
-        const double d2 = dist2[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
-        s.detail[o] = own >= 0 && d2 > kOutlierSigmas * kOutlierSigmas * own;
-      }
+      if (use_pass) s.detail[o] = stands_out_in_own_samples(colour, *vpass, x, yy);
       s.outlier[o] = e > kOutlierSigmas * kOutlierSigmas && !s.detail[o] ? 1 : 0;
     }
   });

@@ -73,4 +73,8 @@ constexpr double kRelMseEps = 0.01;     // relMSE's denominator term, (x - r)^2 
 // the same window relative to each pixel's level and scaled back to the pixel's (.cpp).
 NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads, const Image* variance = nullptr);
 
+// detail(p) above for one pixel, without the rest of the estimate (the firefly clamp's keep
+// mask): false where the pass or the pixel is not finite, or it has no finite neighbour.
+bool stands_out_in_own_samples(const Image& colour, const Image& variance, int x, int y);
+
 }  // namespace mcr

@@ -145,31 +145,14 @@ __attribute__((target("avx2"), flatten)) void rows_avx2(const PwafWindowPass& a,
 }
 #endif
 
-template <template <int> class Rows>
-RowFn by_features(int nf) {
-  switch (nf) {
-    case 0: return &Rows<0>::fn;
-    case 1: return &Rows<1>::fn;
-    case 2: return &Rows<2>::fn;
-    default: return &Rows<3>::fn;
-  }
-}
-template <int NF>
-struct Generic {
-  static void fn(const PwafWindowPass& a, int y0, int y1, int x0, int x1) { rows_generic<NF>(a, y0, y1, x0, x1); }
-};
-#ifdef MCR_X86_DISPATCH
-template <int NF>
-struct Avx2 {
-  static void fn(const PwafWindowPass& a, int y0, int y1, int x0, int x1) { rows_avx2<NF>(a, y0, y1, x0, x1); }
-};
-#endif
-
+// The build for the instruction set in use and `nf` (0 to 3) features.
 RowFn pick(int nf) {
+  static constexpr RowFn generic[] = {rows_generic<0>, rows_generic<1>, rows_generic<2>, rows_generic<3>};
 #ifdef MCR_X86_DISPATCH
-  if (isa_at_least(Isa::Avx2)) return by_features<Avx2>(nf);
+  static constexpr RowFn avx2[] = {rows_avx2<0>, rows_avx2<1>, rows_avx2<2>, rows_avx2<3>};
+  if (isa_at_least(Isa::Avx2)) return avx2[nf];
 #endif
-  return by_features<Generic>(nf);
+  return generic[nf];
 }
 
 constexpr int kBandRows = 8;

@@ -198,11 +198,12 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   // however bright (kernels/noise_scale.h, NoiseScales::detail): never clamped as a firefly.
   std::vector<std::uint8_t> detail;
   if (fireflies)
-    if (const Pass* v = out.frame->find(Role::Variance)) {
-      const NoiseScales ns = estimate_noise_scales(out.colour, demod_region, nthreads, &v->image);
+    if (const Pass* v = out.frame->find(Role::Variance); v && v->image.width() == w && v->image.height() == h) {
       detail.assign(std::size_t(w) * std::size_t(h), 0);
-      for (int y = ns.box.y0; y < ns.box.y1; ++y)
-        for (int x = ns.box.x0; x < ns.box.x1; ++x) detail[std::size_t(y) * std::size_t(w) + std::size_t(x)] = ns.detail[ns.at(x, y)];
+      parallel_rows(work.y0, work.y1, nthreads, [&](int y) {
+        for (int x = work.x0; x < work.x1; ++x)
+          detail[std::size_t(y) * std::size_t(w) + std::size_t(x)] = stands_out_in_own_samples(out.colour, v->image, x, y);
+      });
     }
 
   // Albedo demodulation: filter the illumination, not the texture.
