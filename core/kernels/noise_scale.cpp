@@ -49,6 +49,27 @@ float median_of(float* v, int n) {
 
 double luminance2(const float* m) { return (double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0; }
 
+// The per-channel range [lo, hi] of the 8 neighbours of (x, y) that ok() accepts; false
+// (lo = hi = the pixel) when there is none.
+template <class Ok>
+bool neighbour_range(const Rgb& y, const Ok& ok, int x, int yy, float lo[3], float hi[3]) {
+  const float* p = y.at(x, yy);
+  for (int c = 0; c < 3; ++c) lo[c] = hi[c] = p[c];
+  bool any = false;
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int qx = x + dx, qy = yy + dy;
+      if ((!dx && !dy) || !ok(qx, qy)) continue;
+      const float* q = y.at(qx, qy);
+      for (int c = 0; c < 3; ++c) {
+        lo[c] = any ? std::min(lo[c], q[c]) : q[c];
+        hi[c] = any ? std::max(hi[c], q[c]) : q[c];
+      }
+      any = true;
+    }
+  return any;
+}
+
 // A variance pass at (x, y): the mean over its (at most 3) channels, or -1 where one is not
 // finite and >= 0.
 double pass_variance(const Image& v, int x, int y) {
@@ -69,21 +90,11 @@ bool stands_out_in_own_samples(const Image& colour, const Image& variance, int x
   const double own = pass_variance(variance, x, y);
   if (own < 0 || !rgb.finite(x, y)) return false;
   const float* p = rgb.at(x, y);
-  float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
-  bool any = false;
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int qx = x + dx, qy = y + dy;
-      if ((!dx && !dy) || qx < 0 || qy < 0 || qx >= colour.width() || qy >= colour.height() || !rgb.finite(qx, qy))
-        continue;
-      const float* q = rgb.at(qx, qy);
-      for (int c = 0; c < 3; ++c) {
-        lo[c] = any ? std::min(lo[c], q[c]) : q[c];
-        hi[c] = any ? std::max(hi[c], q[c]) : q[c];
-      }
-      any = true;
-    }
-  if (!any) return false;
+  float lo[3], hi[3];
+  const auto ok = [&](int qx, int qy) {
+    return qx >= 0 && qy >= 0 && qx < colour.width() && qy < colour.height() && rgb.finite(qx, qy);
+  };
+  if (!neighbour_range(rgb, ok, x, y, lo, hi)) return false;
   double d2 = 0;
   for (int c = 0; c < 3; ++c) {
     const double out = double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]);
@@ -209,19 +220,8 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       if (!ok(x, yy)) continue;
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
       const float* p = y.at(x, yy);
-      float lo[3] = {p[0], p[1], p[2]}, hi[3] = {p[0], p[1], p[2]};
-      bool any = false;
-      for (int dy = -1; dy <= 1; ++dy)
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int qx = x + dx, qy = yy + dy;
-          if ((!dx && !dy) || !ok(qx, qy)) continue;
-          const float* q = y.at(qx, qy);
-          for (int c = 0; c < 3; ++c) {
-            lo[c] = any ? std::min(lo[c], q[c]) : q[c];
-            hi[c] = any ? std::max(hi[c], q[c]) : q[c];
-          }
-          any = true;
-        }
+      float lo[3], hi[3];
+      const bool any = neighbour_range(y, ok, x, yy, lo, hi);
       const double rel = tile_of(x, yy);
       double dev = 0;
       for (int c = 0; c < 3; ++c) {
