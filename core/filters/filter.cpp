@@ -2,6 +2,7 @@
 
 #include <algorithm>
 
+#include "kernels/feature_activity.h"
 #include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
 #include "prepare/step_back.h"
@@ -106,6 +107,104 @@ std::vector<Role> Filter::missing_passes(const Frame& frame) const {
   for (Role r : needs().required)
     if (!frame.has(r)) missing.push_back(r);
   return missing;
+}
+
+// ---- Tiled runs ----
+
+namespace {
+
+constexpr int kUnknownReach = 1 << 20;
+// What the noise estimate reads around its box (kernels/noise_scale.h: 12 pixels, and its
+// tiles of 8 on the frame's grid, grown by 4), with room to spare.
+constexpr int kNoiseEstimateReach = 24;
+
+}  // namespace
+
+int Filter::own_reach() const {
+  const Roi probe{kUnknownReach, kUnknownReach, kUnknownReach + 1, kUnknownReach + 1};
+  const Roi r = reads(probe, 2 * kUnknownReach + 1, 2 * kUnknownReach + 1);
+  const int grow = std::max({probe.x0 - r.x0, probe.y0 - r.y0, r.x1 - probe.x1, r.y1 - probe.y1});
+  return grow >= kUnknownReach ? -1 : grow;
+}
+
+std::string Filter::why_not_tileable() const {
+  if (info_.temporal) return "it keeps history between frames";
+  if (info_.deep_input || info_.lightfield_input) return "it reads per-sample data";
+  if (params_.has("foveated") && params_.get_bool("foveated")) return "foveated=true centres on the whole frame";
+  if (own_reach() < 0) return "its reach is not bounded";
+  return "";
+}
+
+int Filter::band_margin() const {
+  if (!(info_.steps.step_back && params_.get_bool("step_back") && step_back_applies())) return 0;
+  return int(params_.get_int("step_back_radius")) + 1 + kNoiseEstimateReach;
+}
+
+int Filter::band_halo() const {
+  if (!why_not_tileable().empty()) return -1;
+  int prep = 1;  // the firefly clamp's keep mask reads the 8 neighbours
+  if (info_.steps.outliers && params_.get_float("firefly_k") > 0) prep += int(params_.get_int("firefly_radius"));
+  if (info_.steps.albedo_prefilter && params_.get_float("albedo_prefilter") > 0) prep += 16;
+  return band_margin() + own_reach() + prep + kNoiseEstimateReach;
+}
+
+void Filter::begin_statistics() {
+  measuring_ranges_.clear();
+  ranges_.clear();
+  measured_holes_ = 0;
+  stats_pass_ = 0;
+  drop_own_statistics();
+  stats_state_ = StatsState::Measuring;
+}
+
+void Filter::measure(const Frame& band, const Roi& rows, int nthreads) {
+  if (!committed_) throw Error(Errc::Internal, "filter '" + info_.name + "': measure() before commit()");
+  if (stats_state_ != StatsState::Measuring) throw Error(Errc::Internal, "filter '" + info_.name + "': measure() outside begin/end_statistics()");
+  check_passes(needs(), band, "filter '" + info_.name + "'");
+  band.check_sizes();
+  notes_.clear();
+  const Roi r = rows.clipped(band.width, band.height);
+  if (r.empty()) return;
+  prepare(band, params_, info_.steps, reads(r, band.width, band.height), nthreads, prepared_);
+  if (stats_pass_ == 0) measured_holes_ += prepared_.holes;
+  for (const Pass& p : prepared_.frame->passes) {
+    if (stats_pass_ > 0) break;
+    if (p.image.channels() < 1) continue;
+    auto it = std::find_if(measuring_ranges_.begin(), measuring_ranges_.end(), [&](const auto& e) { return e.first == p.name; });
+    if (it == measuring_ranges_.end()) it = measuring_ranges_.insert(measuring_ranges_.end(), {p.name, WholeFrameRange{}});
+    extend_frame_range(p.image, std::min(p.image.channels(), 3), r, it->second);
+  }
+  measure_band(*prepared_.frame, prepared_.colour, r, nthreads);
+  prepared_ = Prepared{};
+}
+
+bool Filter::end_statistics_pass() {
+  if (stats_state_ != StatsState::Measuring) throw Error(Errc::Internal, "filter '" + info_.name + "': end_statistics_pass() without begin");
+  if (stats_pass_ == 0) {
+    for (auto& [name, range] : measuring_ranges_) ranges_.emplace_back(name, std::make_shared<const WholeFrameRange>(range));
+    measuring_ranges_.clear();
+  }
+  const bool more = statistics_pass_done();
+  ++stats_pass_;
+  if (more) return true;
+  fix_statistics();
+  stats_state_ = StatsState::Fixed;
+  return false;
+}
+
+void Filter::attach_statistics(Frame& band) const {
+  for (Pass& p : band.passes) {
+    auto it = std::find_if(ranges_.begin(), ranges_.end(), [&](const auto& e) { return e.first == p.name; });
+    p.image.whole_frame = it == ranges_.end() ? nullptr : it->second;
+  }
+}
+
+void Filter::drop_statistics() {
+  measuring_ranges_.clear();
+  ranges_.clear();
+  drop_own_statistics();
+  stats_state_ = StatsState::None;
+  stats_pass_ = 0;
 }
 
 namespace {

@@ -8,6 +8,7 @@
 // the roi the input colour; nothing non-finite leaves).
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "image/pass.h"
@@ -84,6 +85,31 @@ class Filter {
   // filter keeps this at 0 (tests check it).
   std::size_t nonfinite_repaired() const { return repaired_; }
 
+  // ---- Tiled runs (pipeline/tiled_run.h): a frame in bands of rows, same pixels ----
+  // Rows a band needs above and below the rows execute() filters for them to come out as
+  // the whole frame's; -1 when these settings cannot run in bands (why_not_tileable()).
+  int band_halo() const;
+  std::string why_not_tileable() const;
+  // Rows around a band's own that execute() must filter too (the step back's windows read
+  // the filtered result around each pixel).
+  int band_margin() const;
+  // The statistics passes: begin_statistics(); then, while end_statistics_pass() says another
+  // is needed, attach_statistics() and measure() on every band in frame order (`rows`: the
+  // band's own rows, in its coordinates); then attach_statistics() on each band before its
+  // execute(), until drop_statistics(). measure() runs the preparation steps on the band and
+  // records, for its rows, the spread of every pass as the filter reads it (first pass:
+  // Image::whole_frame) and the filter's own frame statistics (measure_band(); a filter whose
+  // statistics build on others, e.g. a guide chosen by a noise level, asks for a second pass).
+  void begin_statistics();
+  void measure(const Frame& band, const Roi& rows, int nthreads);
+  bool end_statistics_pass();
+  void attach_statistics(Frame& band) const;
+  void drop_statistics();
+  bool statistics_fixed() const { return stats_state_ == StatsState::Fixed; }
+  // Unsampled pixels met while measuring (their pull-push fill spans the frame, so a band
+  // fills them from its own rows: not the whole frame's pixels there).
+  std::size_t measured_holes() const { return measured_holes_; }
+
  protected:
   virtual void check_params() {}
   // The filter's own needs under params_ (default: info().required, plus the feature
@@ -106,6 +132,21 @@ class Filter {
   // every pixel of the roi: the base class then passes the colour buffer itself as `out`
   // (the same object: no copy of the frame).
   virtual bool run_in_place() const { return false; }
+  // Pixels beyond a region that run() reads to write it, through every stage of its own
+  // (not the preparation's); -1: unknown (not tileable). Default: from reads().
+  virtual int own_reach() const;
+  // Tiled runs: this band's share of the statistics the filter takes from the whole frame
+  // (band: the prepared passes, colour: the prepared colour; rows: the band's own), then
+  // the combined ones fixed (run() uses them while statistics_fixed()), then dropped.
+  virtual void measure_band(const Frame& band, const Image& colour, const Roi& rows, int nthreads) {
+    (void)band, (void)colour, (void)rows, (void)nthreads;
+  }
+  virtual void fix_statistics() {}
+  // The pass just measured is complete: true to measure every band again (statistics_pass()
+  // then counts it), false when the filter's statistics are fixed.
+  virtual bool statistics_pass_done() { return false; }
+  int statistics_pass() const { return stats_pass_; }
+  virtual void drop_own_statistics() {}
   // Whether the step back (prepare/step_back.h) applies to the result run() just gave: its
   // limits assume a spatial estimate from this frame's input (a temporal filter's output
   // built from history may lie outside this frame's local range, rightly).
@@ -125,6 +166,12 @@ class Filter {
   Prepared prepared_;
   std::vector<std::string> unused_, notes_;
   std::size_t repaired_ = 0;
+  enum class StatsState { None, Measuring, Fixed };
+  StatsState stats_state_ = StatsState::None;
+  std::vector<std::pair<std::string, WholeFrameRange>> measuring_ranges_;  // by pass name
+  std::vector<std::pair<std::string, std::shared_ptr<const WholeFrameRange>>> ranges_;
+  std::size_t measured_holes_ = 0;
+  int stats_pass_ = 0;
 };
 
 }  // namespace mcr

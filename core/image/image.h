@@ -1,6 +1,7 @@
 #pragma once
 // Float image with interleaved channels, the currency of every pass and filter.
 #include <cstddef>
+#include <memory>
 #include <vector>
 
 namespace mcr {
@@ -17,6 +18,17 @@ struct Roi {
   Roi grown(int by, int w, int h) const { return Roi{x0 - by, y0 - by, x1 + by, y1 + by}.clipped(w, h); }
   bool contains(int x, int y) const { return x >= x0 && x < x1 && y >= y0 && y < y1; }
   bool operator==(const Roi& o) const { return x0 == o.x0 && y0 == o.y0 && x1 == o.x1 && y1 == o.y1; }
+};
+
+// The spread of an image over the whole frame when the image holds a band of it (a tiled
+// run, pipeline/tiled_run.h): what kernels/feature_activity.h asks of a pass, answered for
+// the frame instead of the band. Over the pixels whose `channels` first channels are all
+// finite ("counted"): the first one in row-major order, and each channel's least and
+// greatest value.
+struct WholeFrameRange {
+  int channels = 0;
+  bool any_counted = false, some_uncounted = false;
+  float first[4] = {0, 0, 0, 0}, lo[4] = {0, 0, 0, 0}, hi[4] = {0, 0, 0, 0};
 };
 
 class Image {
@@ -42,6 +54,9 @@ class Image {
 
   // A copy holding channels [first, first+count) of this image.
   Image channel_range(int first, int count) const;
+
+  // Set on a band's passes by a tiled run (null otherwise); copies share it.
+  std::shared_ptr<const WholeFrameRange> whole_frame;
 
  private:
   std::size_t index(int x, int y) const {

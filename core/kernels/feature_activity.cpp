@@ -24,6 +24,50 @@ inline bool read_pixel(const float* p, int nc, int channels, float* v) {
 
 }  // namespace
 
+FeatureActivity activity_over_frame(const WholeFrameRange& r, const Tolerance& tol) {
+  FeatureActivity a;
+  a.channels = r.channels;
+  if (!r.any_counted) return a;
+  std::copy(r.first, r.first + 4, a.value);
+  a.kind = Activity::Constant;
+  // The scan's test |v - ref| <= t in float: rounding is monotonic, so its largest value over
+  // the frame is at a channel's least or greatest value.
+  for (int c = 0; c < r.channels; ++c) {
+    const float t = float(tol.abs + tol.rel * std::fabs(double(r.first[c])));
+    if (!(std::fabs(r.hi[c] - r.first[c]) <= t) || !(std::fabs(r.lo[c] - r.first[c]) <= t)) {
+      a.kind = Activity::Varies;
+      return a;
+    }
+  }
+  a.some_nonfinite = r.some_uncounted;
+  return a;
+}
+
+void extend_frame_range(const Image& im, int channels, const Roi& rows, WholeFrameRange& r) {
+  if (channels < 1 || channels > 4 || im.channels() < 1)
+    throw Error(Errc::Internal, "extend_frame_range: bad channel count " + std::to_string(channels));
+  r.channels = channels;
+  const int nc = im.channels();
+  float v[4];
+  for (int y = rows.y0; y < rows.y1; ++y)
+    for (int x = rows.x0; x < rows.x1; ++x) {
+      if (!read_pixel(im.pixel(x, y), nc, channels, v)) {
+        r.some_uncounted = true;
+        continue;
+      }
+      if (!r.any_counted) {
+        r.any_counted = true;
+        std::copy(v, v + channels, r.first);
+        std::copy(v, v + channels, r.lo);
+        std::copy(v, v + channels, r.hi);
+      }
+      for (int c = 0; c < channels; ++c) {
+        r.lo[c] = std::min(r.lo[c], v[c]);
+        r.hi[c] = std::max(r.hi[c], v[c]);
+      }
+    }
+}
+
 FeatureActivity feature_activity(const Image& im, int channels, const Roi& region, const Tolerance& tol,
                                  int nthreads) {
   if (channels < 1 || channels > 4 || im.channels() < 1)
@@ -31,6 +75,7 @@ FeatureActivity feature_activity(const Image& im, int channels, const Roi& regio
   FeatureActivity a;
   a.channels = channels;
   if (region.empty()) return a;
+  if (im.whole_frame && im.whole_frame->channels == channels) return activity_over_frame(*im.whole_frame, tol);
   const int nc = im.channels();
   // The first counted pixel, row-major: the reference.
   int fx = -1, fy = -1;

@@ -45,9 +45,16 @@ inline constexpr double kConstantSigmaFraction = 0.004;
 inline double constant_tolerance(double sigma) { return kConstantSigmaFraction * sigma; }
 
 // Reads channels [0, channels) of `im` (the last channel repeated when it has fewer),
-// channels in 1..4, over `region` (inside the image).
+// channels in 1..4, over `region` (inside the image). An image that holds a band of a frame
+// in a tiled run (Image::whole_frame, for these channels) is answered for the whole frame,
+// whatever the region: the answer the whole frame's run gets (its region is the frame).
 FeatureActivity feature_activity(const Image& im, int channels, const Roi& region, const Tolerance& tol,
                                  int nthreads);
+
+// The same answer from a frame's range (exact: the scan's float test is monotonic).
+FeatureActivity activity_over_frame(const WholeFrameRange& range, const Tolerance& tol);
+// Adds rows of a band (in row-major order of the frame: bands in order) to a frame's range.
+void extend_frame_range(const Image& im, int channels, const Roi& rows, WholeFrameRange& range);
 
 // "normal pass is constant over the frame (0.000, 0.000, 1.000): normal weight not used",
 // or "... has no finite value over ...". `region` names where ("the frame" when the region

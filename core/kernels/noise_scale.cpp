@@ -187,12 +187,15 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   });
 
   // Robust scale per tile of the box: the median relative residual of the tile's window.
-  const int ntx = (s.box.width() + kTile - 1) / kTile, nty = (s.box.height() + kTile - 1) / kTile;
+  // The tiles lie on the frame's grid (multiples of kTile from 0), whatever the box: a band of
+  // a frame (pipeline/tiled_run.h) sees the tiles the whole frame does.
+  const int gx0 = s.box.x0 - s.box.x0 % kTile, gy0 = s.box.y0 - s.box.y0 % kTile;
+  const int ntx = (s.box.x1 - gx0 + kTile - 1) / kTile, nty = (s.box.y1 - gy0 + kTile - 1) / kTile;
   std::vector<float> tile_rel(std::size_t(ntx) * std::size_t(nty), 0.0f);
   parallel_rows(0, nty, nthreads, [&](int ty) {
     std::vector<float> buf;
     for (int tx = 0; tx < ntx; ++tx) {
-      const int x0 = s.box.x0 + tx * kTile, y0 = s.box.y0 + ty * kTile;
+      const int x0 = gx0 + tx * kTile, y0 = gy0 + ty * kTile;
       const Roi win = Roi{x0, y0, x0 + kTile, y0 + kTile}.grown(kTileGrow, W, H);
       buf.clear();
       for (int yy = win.y0; yy < win.y1; ++yy)
@@ -211,8 +214,8 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   const Roi E = s.box.grown(kVarianceRadius + 1, W, H);
   std::vector<float> exc(std::size_t(E.width()) * std::size_t(E.height()), 0.0f);
   auto tile_of = [&](int x, int yy) {
-    const int tx = std::min(std::max((x - s.box.x0) / kTile, 0), ntx - 1);
-    const int ty = std::min(std::max((yy - s.box.y0) / kTile, 0), nty - 1);
+    const int tx = std::min(std::max((x - gx0) / kTile, 0), ntx - 1);
+    const int ty = std::min(std::max((yy - gy0) / kTile, 0), nty - 1);
     return tile_rel[std::size_t(ty) * std::size_t(ntx) + std::size_t(tx)];
   };
   parallel_rows(E.y0, E.y1, nthreads, [&](int yy) {
@@ -239,7 +242,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   std::vector<std::uint8_t> rare(std::size_t(ntx) * std::size_t(nty), 0);
   parallel_rows(0, nty, nthreads, [&](int ty) {
     for (int tx = 0; tx < ntx; ++tx) {
-      const int x0 = s.box.x0 + tx * kTile, y0 = s.box.y0 + ty * kTile;
+      const int x0 = gx0 + tx * kTile, y0 = gy0 + ty * kTile;
       const Roi win = Roi{x0, y0, x0 + kTile, y0 + kTile}.grown(kTileGrow, W, H);
       int n = 0, out = 0;
       for (int yy = std::max(win.y0, E.y0); yy < std::min(win.y1, E.y1); ++yy)
@@ -255,8 +258,8 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
     if (!ok(x, yy)) return false;
     if (exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] <= kOutlierSigmas * kOutlierSigmas)
       return true;
-    const int tx = std::min(std::max((x - s.box.x0) / kTile, 0), ntx - 1);
-    const int ty = std::min(std::max((yy - s.box.y0) / kTile, 0), nty - 1);
+    const int tx = std::min(std::max((x - gx0) / kTile, 0), ntx - 1);
+    const int ty = std::min(std::max((yy - gy0) / kTile, 0), nty - 1);
     return !rare[std::size_t(ty) * std::size_t(ntx) + std::size_t(tx)];
   };
 

@@ -160,6 +160,7 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   out.frame = &frame;
   out.notes.clear();
   out.divisor = Image();
+  out.holes = 0;
   const int w = frame.width, h = frame.height;
   const Roi work = work_in.clipped(w, h);
   // Each step reads around the region of the next: fireflies read their window.
@@ -174,8 +175,8 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
       Frame& f = own_frame(frame, out);
       for (Pass& p : f.passes)
         if (p.role != Role::SampleCount && p.role != Role::Alpha) pull_push_fill(p.image, holes, nthreads);
-      out.notes.push_back("filled " + std::to_string(std::count(holes.begin(), holes.end(), 0.0f)) +
-                          " unsampled pixels by pull-push");
+      out.holes = std::size_t(std::count(holes.begin(), holes.end(), 0.0f));
+      out.notes.push_back("filled " + std::to_string(out.holes) + " unsampled pixels by pull-push");
     }
   }
   // Albedo prefilter: every later use of the albedo pass sees the smoothed one.
@@ -186,6 +187,7 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
       ap.position_sigma = params.get_float("albedo_prefilter_position");
       // Albedo weights read it over the filter's whole reach: smooth the work region.
       Image smooth = prefilter_albedo(*out.frame, *a, ap, work, nthreads);
+      smooth.whole_frame = a->image.whole_frame;  // a tiled run measured the smoothed one
       const std::size_t index = std::size_t(a - out.frame->passes.data());
       own_frame(frame, out).passes[index].image = std::move(smooth);
     } else {

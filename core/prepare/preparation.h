@@ -60,6 +60,7 @@ struct Prepared {
   Image divisor;                 // the demodulation divisor (RGB); empty when not demodulated
   std::vector<std::string> notes;
   Frame own;                     // storage when a step changed a pass
+  std::size_t holes = 0;         // unsampled pixels filled
 };
 
 // Runs the steps over `work` (clipped to the frame). Throws MissingPass naming the frame's

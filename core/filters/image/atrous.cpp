@@ -81,6 +81,13 @@ void AtrousFilter::check_params() {
   check_foveation_params(params_, info().name);
 }
 
+int AtrousFilter::own_reach() const {
+  const int half = int(params_.get_int("kernel_size")) / 2, iterations = int(params_.get_int("iterations"));
+  int reach = 0;
+  for (int i = 0; i < iterations && reach < (1 << 20); ++i) reach += half * (1 << i);
+  return reach + 4;  // colour_weight=noise: the 3x3 variance and its 3x3 smoothing
+}
+
 void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
   const int w = frame.width, h = frame.height;
   const int kg = int(params_.get_int("kernel_size"));

@@ -20,6 +20,7 @@ class AtrousFilter : public Filter {
 
  protected:
   void check_params() override;
+  int own_reach() const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:

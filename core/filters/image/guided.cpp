@@ -49,10 +49,16 @@ double guided::auto_epsilon(double scale, double median_relative_noise) {
 }
 
 guided::FrameNoise guided::frame_noise(const Image& colour, int nthreads) {
-  const NoiseScales ns = estimate_noise_scales(colour, Roi::all(colour.width(), colour.height()), nthreads);
   std::vector<double> rel, abs;
-  rel.reserve(ns.relative.size());
-  abs.reserve(ns.relative.size());
+  gather_frame_noise(colour, Roi::all(colour.width(), colour.height()), nthreads, rel, abs);
+  return frame_noise_of(rel, abs);
+}
+
+void guided::gather_frame_noise(const Image& colour, const Roi& rows, int nthreads, std::vector<double>& rel,
+                                std::vector<double>& abs) {
+  const NoiseScales ns = estimate_noise_scales(colour, rows, nthreads);
+  rel.reserve(rel.size() + ns.relative.size());
+  abs.reserve(abs.size() + ns.relative.size());
   // Over the pixels whose tile measured any noise: at 1 spp a render lit by rare paths is
   // mostly black, and a black tile's noise is not 0 but unmeasured (its median is 0).
   for (std::size_t i = 0; i < ns.relative.size(); ++i) {
@@ -60,6 +66,9 @@ guided::FrameNoise guided::frame_noise(const Image& colour, int nthreads) {
     if (std::isfinite(ns.relative[i])) rel.push_back(ns.relative[i]);
     if (std::isfinite(ns.robust(i))) abs.push_back(ns.robust(i));
   }
+}
+
+guided::FrameNoise guided::frame_noise_of(std::vector<double>& rel, std::vector<double>& abs) {
   auto median = [](std::vector<double>& v) {
     if (v.empty()) return 0.0;
     auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
@@ -81,15 +90,12 @@ namespace {
 template <int D>
 void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std::vector<bool>& unit,
               const std::vector<double>& min_scale, const Roi& roi,
-              Image& out, int nthreads, GuidedStats& st, std::vector<std::vector<double>>& work) {
+              Image& out, int nthreads, GuidedStats& st, std::vector<std::vector<double>>& work,
+              std::vector<RowStats>* measure_rows, const std::vector<RowStats>* fixed_rows) {
   const int W = c.w, H = c.h;
   const std::size_t N = std::size_t(W) * std::size_t(H);
   std::vector<std::uint8_t> flags(N);
-  struct RowStats {
-    std::uint64_t n = 0, invalid = 0;
-    double mean[D] = {}, m2[D] = {};
-    std::uint32_t hist[256] = {};
-  };
+  static_assert(D <= kMaxGuideChannels, "guide channels");
   std::vector<RowStats> rows(static_cast<std::size_t>(H));
   parallel_rows(0, H, nthreads, [&](int y) {
     const GuideView<D> gv(c);
@@ -143,11 +149,16 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
     std::copy(mean, mean + D, rs.mean);
     std::copy(m2, m2 + D, rs.m2);
   });
+  // A tiled run's statistics pass: the band's own rows, in frame order; nothing filtered.
+  if (measure_rows) {
+    for (int y = roi.y0; y < roi.y1; ++y) measure_rows->push_back(rows[std::size_t(y)]);
+    return;
+  }
   // Rows combined in order (Chan, Golub & LeVeque): mean and sum of squared deviations.
   double n = 0, mean[D] = {}, m2[D] = {};
   std::array<std::uint64_t, 256> hist{};
   std::size_t invalid = 0;
-  for (const RowStats& rs : rows) {
+  for (const RowStats& rs : fixed_rows ? *fixed_rows : rows) {
     invalid += rs.invalid;
     for (int b = 0; b < 256; ++b) hist[std::size_t(b)] += rs.hist[b];
     if (!rs.n) continue;
@@ -180,6 +191,8 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
   }
   std::size_t outliers = 0;
   if (any_outlier) {
+    // Counted over the image given (a tiled run's band: its own; any_outlier, which is what
+    // changes the filtering, is the frame's from the histogram).
     std::vector<std::uint32_t> row_out(std::size_t(H), 0);
     parallel_rows(0, H, nthreads, [&](int y) {
       for (int x = 0; x < W; ++x) {
@@ -227,7 +240,7 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
   bool mp = false;
   for (int y = roi.y0; y < roi.y1 && !mp; ++y)
     for (int x = roi.x0; x < roi.x1; ++x) mp = mp || !(flags[std::size_t(y) * std::size_t(W) + std::size_t(x)] & kGuideOk);
-  run_bands<D>(c, outliers != 0, mp, roi, out, nthreads, band_h, work);
+  run_bands<D>(c, any_outlier, mp, roi, out, nthreads, band_h, work);
 }
 
 }  // namespace
@@ -312,7 +325,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   c.eps = params_.get_float("epsilon");
   double colour_scale = 0;  // epsilon=0: a colour guide is divided by at least its level
   if (c.eps == 0.0) {
-    const FrameNoise fn = frame_noise(*colour, nthreads);
+    const FrameNoise fn = statistics_fixed() || measuring_rows_ ? fixed_noise_ : frame_noise(*colour, nthreads);
     c.eps = auto_epsilon(params_.get_float("epsilon_scale"), fn.relative);
     colour_scale = fn.level;
     note("epsilon " + number_text(c.eps) + " from the noise (median relative noise variance " + number_text(fn.relative) +
@@ -352,14 +365,49 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   }
 
   stats_ = GuidedStats{};
+  std::vector<RowStats>* rows_in = measuring_rows_ ? &row_stats_ : nullptr;
+  const std::vector<RowStats>* rows_fixed = statistics_fixed() ? &row_stats_ : nullptr;
   switch (d) {
-    case 1: filter_d<1>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
-    case 3: filter_d<3>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
-    case 4: filter_d<4>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
-    case 6: filter_d<6>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
-    case 7: filter_d<7>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_); break;
+    case 1: filter_d<1>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_, rows_in, rows_fixed); break;
+    case 3: filter_d<3>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_, rows_in, rows_fixed); break;
+    case 4: filter_d<4>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_, rows_in, rows_fixed); break;
+    case 6: filter_d<6>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_, rows_in, rows_fixed); break;
+    case 7: filter_d<7>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_, rows_in, rows_fixed); break;
     default: throw Error(Errc::Internal, "filter 'guided': no kernel for a " + std::to_string(d) + "-channel guide");
   }
+}
+
+void GuidedFilter::measure_band(const Frame& band, const Image& colour, const Roi& rows, int nthreads) {
+  // First pass: the noise (epsilon=0) and, in the base class, every pass's spread; then the
+  // guides that epsilon and those spreads leave active, and their statistics.
+  if (statistics_pass() == 0) {
+    if (noise_from_image()) gather_frame_noise(colour, rows, nthreads, measured_rel_, measured_abs_);
+    return;
+  }
+  measuring_rows_ = true;
+  try {
+    Image none;
+    run(band, colour, rows, none, nthreads);
+  } catch (...) {
+    measuring_rows_ = false;
+    throw;
+  }
+  measuring_rows_ = false;
+}
+
+bool GuidedFilter::statistics_pass_done() {
+  if (statistics_pass() > 0) return false;
+  if (noise_from_image()) fixed_noise_ = frame_noise_of(measured_rel_, measured_abs_);
+  std::vector<double>().swap(measured_rel_);
+  std::vector<double>().swap(measured_abs_);
+  return true;
+}
+
+void GuidedFilter::drop_own_statistics() {
+  std::vector<double>().swap(measured_rel_);
+  std::vector<double>().swap(measured_abs_);
+  std::vector<RowStats>().swap(row_stats_);
+  fixed_noise_ = {};
 }
 
 }  // namespace mcr

@@ -68,6 +68,20 @@ struct FrameNoise {
   double relative = 0, level = 0;
 };
 FrameNoise frame_noise(const Image& colour, int nthreads);
+// The values frame_noise() takes the medians of, for `rows` (appended), and their medians
+// (reordering them): a tiled run gathers them band by band.
+void gather_frame_noise(const Image& colour, const Roi& rows, int nthreads, std::vector<double>& relative,
+                        std::vector<double>& robust);
+FrameNoise frame_noise_of(std::vector<double>& relative, std::vector<double>& robust);
+
+// One row's share of the guide statistics (validity count, mean and squared deviations per
+// guide channel, exponent histogram of the colour), combined over the rows in order.
+constexpr int kMaxGuideChannels = 7;
+struct RowStats {
+  std::uint64_t n = 0, invalid = 0;
+  double mean[kMaxGuideChannels] = {}, m2[kMaxGuideChannels] = {};
+  std::uint32_t hist[256] = {};
+};
 double auto_epsilon(double scale, double median_relative_noise);
 }  // namespace guided
 
@@ -95,11 +109,22 @@ class GuidedFilter : public Filter {
  protected:
   PassNeeds own_needs() const override;
   std::vector<std::string> own_unused() const override;
+  int own_reach() const override { return 2 * int(params_.get_int("radius")) + 1; }
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:
+  void measure_band(const Frame& band, const Image& colour, const Roi& rows, int nthreads) override;
+  bool statistics_pass_done() override;
+  void drop_own_statistics() override;
+  bool noise_from_image() const { return params_.get_float("epsilon") == 0.0; }
+
   GuidedStats stats_;
   std::vector<std::vector<double>> work_;  // per row band, kept between calls
+  // Tiled runs: the frame's noise (epsilon=0; a first pass) and every row's guide statistics.
+  std::vector<double> measured_rel_, measured_abs_;
+  guided::FrameNoise fixed_noise_;
+  std::vector<guided::RowStats> row_stats_;
+  bool measuring_rows_ = false;
 };
 
 }  // namespace mcr

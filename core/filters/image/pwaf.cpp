@@ -43,37 +43,53 @@ bool feature_at(const Image& im, int x, int y, float v[3]) {
   return finite3(v);
 }
 
-Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing) {
+// The non-zero distances between horizontally and vertically adjacent finite pixels whose
+// first pixel lies in `rows` (the pair below a row's pixel is taken where the image has it).
+void adjacent_distances(const Image& im, const Roi& rows, std::vector<double>& d) {
+  const int w = im.width(), h = im.height();
+  auto dist = [&](int x0, int y0, int x1, int y1) {
+    float a[3], b[3];
+    if (!feature_at(im, x0, y0, a) || !feature_at(im, x1, y1, b)) return;
+    double s = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double t = double(a[c]) - double(b[c]);
+      s += t * t;
+    }
+    if (s > 0) d.push_back(std::sqrt(s));
+  };
+  for (int y = rows.y0; y < rows.y1; ++y)
+    for (int x = 0; x < w; ++x) {
+      if (x + 1 < w) dist(x, y, x + 1, y);
+      if (y + 1 < h) dist(x, y, x, y + 1);
+    }
+}
+
+// The median of the values (0 when there are none); reorders them.
+double median_of(std::vector<double>& v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
+  return v[v.size() / 2];
+}
+
+// spacing: the frame's median adjacent distance when measured beforehand (a tiled run), else
+// negative: measured here over the whole image.
+Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing, double spacing) {
   Feature f;
   if (!pass) return f;
   f.image = &pass->image;
   const Image& im = pass->image;
-  const int w = im.width(), h = im.height();
   double scale = 1.0;
   if (scale_by_spacing) {
     // Positions are in scene units: sigma is given in units of the frame's median distance
     // between horizontally or vertically adjacent pixels (non-zero distances of finite pairs),
     // so one default fits any scene scale. Computed over the whole frame, whatever the roi.
-    std::vector<double> d;
-    d.reserve(std::size_t(w) * h * 2);
-    auto dist = [&](int x0, int y0, int x1, int y1) {
-      float a[3], b[3];
-      if (!feature_at(im, x0, y0, a) || !feature_at(im, x1, y1, b)) return;
-      double s = 0;
-      for (int c = 0; c < 3; ++c) {
-        const double t = double(a[c]) - double(b[c]);
-        s += t * t;
-      }
-      if (s > 0) d.push_back(std::sqrt(s));
-    };
-    for (int y = 0; y < h; ++y)
-      for (int x = 0; x < w; ++x) {
-        if (x + 1 < w) dist(x, y, x + 1, y);
-        if (y + 1 < h) dist(x, y, x, y + 1);
-      }
-    if (!d.empty()) {
-      std::nth_element(d.begin(), d.begin() + std::ptrdiff_t(d.size() / 2), d.end());
-      scale = d[d.size() / 2];
+    if (spacing >= 0) {
+      if (spacing > 0) scale = spacing;
+    } else {
+      std::vector<double> d;
+      d.reserve(std::size_t(im.width()) * std::size_t(im.height()) * 2);
+      adjacent_distances(im, Roi::all(im.width(), im.height()), d);
+      if (!d.empty()) scale = median_of(d);
     }
   }
   const double s = sigma * scale;
@@ -157,6 +173,47 @@ void PwafFilter::check_params() {
   if (params_.get_int("min_radius") > params_.get_int("max_radius"))
     throw Error(Errc::InvalidArgument, "filter 'pwaf': min_radius (" + std::to_string(params_.get_int("min_radius")) +
                                            ") must not exceed max_radius (" + std::to_string(params_.get_int("max_radius")) + ")");
+}
+
+void PwafFilter::measure_band(const Frame& band, const Image& colour, const Roi& rows, int nthreads) {
+  const Pass* pos = band.find(Role::SecondPosition);
+  if (!pos) pos = band.find(Role::Position, Prefer::Geometry);
+  if (pos) adjacent_distances(pos->image, rows, measured_spacing_);
+  if (!params_.get_bool("adaptive")) return;
+  measuring_ = true;
+  try {
+    Image none;
+    run(band, colour, rows, none, nthreads);
+  } catch (...) {
+    measuring_ = false;
+    throw;
+  }
+  measuring_ = false;
+}
+
+void PwafFilter::fix_statistics() {
+  fixed_spacing_ = median_of(measured_spacing_);
+  fixed_rho_median_ = median_of(measured_rho_);
+  drop_measured();
+}
+
+void PwafFilter::drop_measured() {
+  std::vector<double>().swap(measured_spacing_);
+  std::vector<double>().swap(measured_rho_);
+}
+
+void PwafFilter::drop_own_statistics() {
+  drop_measured();
+  fixed_spacing_ = fixed_rho_median_ = 0;
+}
+
+int PwafFilter::own_reach() const {
+  // The window over the range value (the prefilter) and the variance (its window of 8-neighbour
+  // residuals), both over the outlier-replaced colour.
+  const double pf_sigma = params_.get_float("prefilter_sigma");
+  const int pf_r = pf_sigma > 0 ? int(std::ceil(3.0 * pf_sigma)) : 0;
+  return int(params_.get_int("max_radius")) + std::max(pf_r, int(params_.get_int("variance_radius")) + 1) +
+         int(params_.get_int("outlier_radius")) + 2;
 }
 
 std::vector<std::string> PwafFilter::own_unused() const {
@@ -310,14 +367,21 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
         rho[i] = pwaf::relative_variance(variance[i], luminance(est.pixel(x, y)));
       }
     });
-    std::vector<double> sorted;
-    sorted.reserve(rho.size());
-    for (std::size_t i = 0; i < rho.size(); ++i)
-      if (valid[i] && std::isfinite(rho[i])) sorted.push_back(rho[i]);
-    double median = 0;
-    if (!sorted.empty()) {
-      std::nth_element(sorted.begin(), sorted.begin() + std::ptrdiff_t(sorted.size() / 2), sorted.end());
-      median = sorted[sorted.size() / 2];
+    if (measuring_) {  // a tiled run's statistics pass: this band's rows, nothing filtered
+      for (int y = roi.y0; y < roi.y1; ++y)
+        for (int x = roi.x0; x < roi.x1; ++x) {
+          const std::size_t i = std::size_t(y) * w + x;
+          if (valid[i] && std::isfinite(rho[i])) measured_rho_.push_back(rho[i]);
+        }
+      return;
+    }
+    double median = fixed_rho_median_;
+    if (!statistics_fixed()) {
+      std::vector<double> sorted;
+      sorted.reserve(rho.size());
+      for (std::size_t i = 0; i < rho.size(); ++i)
+        if (valid[i] && std::isfinite(rho[i])) sorted.push_back(rho[i]);
+      median = median_of(sorted);
     }
     stats_.median_rel_variance = median;
     const double rho_max = variance_max * median;
@@ -353,7 +417,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     FeatureActivity a = feature_activity(pass->image, 3, fr, 0.0, nthreads);
     Feature f;
     if (a.kind == Activity::Varies) {
-      f = make_feature(pass, sigma, scale_by_spacing);
+      f = make_feature(pass, sigma, scale_by_spacing, statistics_fixed() ? fixed_spacing_ : -1.0);
       a = feature_activity(pass->image, 3, fr, constant_tolerance(std::sqrt(0.5 / f.inv2s2)), nthreads);
       if (a.kind == Activity::Varies) return f;
     }

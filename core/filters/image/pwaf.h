@@ -54,11 +54,21 @@ class PwafFilter : public Filter {
 
  protected:
   void check_params() override;
+  int own_reach() const override;
+  void measure_band(const Frame& band, const Image& colour, const Roi& rows, int nthreads) override;
+  void fix_statistics() override;
+  void drop_own_statistics() override;
   std::vector<std::string> own_unused() const override;
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:
+  void drop_measured();
   PwafStats stats_;
+  // Tiled runs: the frame's median adjacent position distance and median relative variance
+  // (measured band by band, then fixed).
+  bool measuring_ = false;
+  std::vector<double> measured_spacing_, measured_rho_;
+  double fixed_spacing_ = 0, fixed_rho_median_ = 0;
 };
 
 // The building blocks, public so the tests can check each rule on its own.

@@ -1,0 +1,108 @@
+#include "pipeline/tiled_run.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+
+#include "util/error.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+Frame frame_rows(const Frame& frame, int y0, int y1) {
+  if (frame.deep || frame.lightfield)
+    throw Error(Errc::InvalidArgument, "'" + frame.path + "' is a deep file: it is filtered whole, not in bands");
+  if (y0 < 0 || y1 > frame.height || y0 >= y1)
+    throw Error(Errc::Internal, "frame_rows: rows " + std::to_string(y0) + ".." + std::to_string(y1) + " outside the frame");
+  Frame f = frame.header(frame.width, y1 - y0);
+  f.window = frame.window;
+  auto rows_of = [&](const Pass& p) {
+    const Image& im = p.image;
+    Image band(im.width(), y1 - y0, im.channels());
+    const std::size_t row = std::size_t(im.width()) * std::size_t(im.channels());
+    if (row) std::memcpy(band.data(), im.pixel(0, y0), row * std::size_t(y1 - y0) * sizeof(float));
+    return with_pixels(p, std::move(band));
+  };
+  for (const Pass& p : frame.passes) f.passes.push_back(rows_of(p));
+  return f;
+}
+
+Frame FrameRows::rows(int y0, int y1) { return frame_rows(frame_, y0, y1); }
+
+BandPlan plan_bands(int height, int band_rows, int halo) {
+  BandPlan p;
+  p.halo = std::max(0, halo);
+  const int aligned = std::max(kBandAlign, (std::max(band_rows, 1) + kBandAlign - 1) / kBandAlign * kBandAlign);
+  p.band_rows = std::min(aligned, std::max(height, 1));
+  p.bands = height <= 0 ? 0 : (height + p.band_rows - 1) / p.band_rows;
+  return p;
+}
+
+namespace {
+
+void add_notes(const std::vector<std::string>& from, std::vector<std::string>& to) {
+  for (const std::string& n : from)
+    if (std::find(to.begin(), to.end(), n) == to.end()) to.push_back(n);
+}
+
+}  // namespace
+
+Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes) {
+  const int halo = filter.band_halo(), margin = filter.band_margin();
+  if (halo < 0)
+    throw Error(Errc::InvalidArgument, "filter '" + filter.info().name + "' cannot run in bands under these settings (" +
+                                           filter.why_not_tileable() + ")");
+  const int w = source.width(), h = source.height();
+  const BandPlan plan = plan_bands(h, options.band_rows, halo);
+  std::vector<std::string> said;
+  auto band_of = [&](int b, Roi& rows) {
+    const int y0 = b * plan.band_rows, y1 = std::min(h, y0 + plan.band_rows);
+    // The halo rounded out to whole alignment steps: a band's frame starts on the grid too.
+    const int r0 = std::max(0, (y0 - plan.halo) / kBandAlign * kBandAlign);
+    const int r1 = std::min(h, y1 + plan.halo);
+    rows = Roi{0, y0 - r0, w, y1 - r0};
+    return std::make_pair(r0, r1);
+  };
+
+  filter.begin_statistics();
+  try {
+    do {
+      for (int b = 0; b < plan.bands; ++b) {
+        Roi rows;
+        const auto [r0, r1] = band_of(b, rows);
+        Frame band = source.rows(r0, r1);
+        filter.attach_statistics(band);
+        filter.measure(band, rows, options.nthreads);
+      }
+    } while (filter.end_statistics_pass());
+  } catch (...) {
+    filter.drop_statistics();
+    throw;
+  }
+
+  Image out(w, h, 3);
+  try {
+    for (int b = 0; b < plan.bands; ++b) {
+      Roi rows;
+      const auto [r0, r1] = band_of(b, rows);
+      Frame band = source.rows(r0, r1);
+      filter.attach_statistics(band);
+      ExecOptions eo;
+      eo.nthreads = options.nthreads;
+      eo.roi = rows.grown(margin, band.width, band.height);
+      const Image part = filter.execute(band, eo);
+      const std::size_t row = std::size_t(w) * 3;
+      std::memcpy(out.pixel(0, r0 + rows.y0), part.pixel(0, rows.y0), row * std::size_t(rows.height()) * sizeof(float));
+      add_notes(filter.notes(), said);
+      if (options.progress) options.progress(b + 1, plan.bands);
+    }
+  } catch (...) {
+    filter.drop_statistics();
+    throw;
+  }
+  filter.drop_statistics();
+  if (notes) *notes = std::move(said);
+  return out;
+}
+
+}  // namespace mcr
