@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <iostream>
+#include <memory>
 #include <regex>
 
 #include "commands.h"
@@ -27,6 +28,7 @@ struct DenoiseArgs {
   bool serial = false;      // --serial: no overlap of read, filter and write
   int threads = 0;
   int warmup = -1;  // --warmup N; -1: not given
+  int max_memory = 0, band_rows = 0;  // --max-memory MB, --band-rows N: a single frame in bands
   DisplayTransform display;  // PNG/JPEG/TIFF outputs
   int bits = 0;
 };
@@ -141,6 +143,27 @@ int run_denoise(const DenoiseArgs& a) {
       }
     }
   }
+  if (a.max_memory > 0 || a.band_rows > 0) {
+    const std::string opt = a.band_rows > 0 ? "--band-rows" : "--max-memory";
+    if (seq) throw Error(Errc::InvalidArgument, opt + " applies to one frame; run a sequence's frames one call each");
+    if (!a.half.empty()) throw Error(Errc::InvalidArgument, opt + ": --half merges two whole frames; not in bands");
+    if (done[0]) {
+      std::cerr << "mcrecon: " << a.output << " is done (same filter, parameters and input): kept (--resume)\n";
+      return 0;
+    }
+    std::unique_ptr<Progress> bar;
+    const StageTimes t = session.run_in_bands(a.input, a.output, ro, wo, eo, a.band_rows,
+                                              double(a.max_memory) * 1024.0 * 1024.0, [&](int d, int all) {
+                                                if (!bar) bar = std::make_unique<Progress>("denoise " + a.filter + " in bands", all);
+                                                bar->step(d, d * 2 <= all ? "statistics" : "filter");
+                                              });
+    if (bar) bar->finish(a.output);
+    if (a.verbose)
+      for (const auto& n : t.notes)
+        if (std::find(unused.begin(), unused.end(), n) == unused.end()) std::cerr << "mcrecon: " << a.input << ": " << n << "\n";
+    if (a.timings || a.verbose) std::cerr << "mcrecon: " << a.output << ": " << times_text(t) << "\n";
+    return 0;
+  }
   const std::vector<FrameJob> jobs = plan_sequence(frames, done, temporal, a.warmup);
   // Warm-up frames before the list's first: they must exist, and no output may fall on one.
   const std::size_t listed = inputs.size();
@@ -235,6 +258,12 @@ Run add_denoise(CLI::App& app) {
   app.add_flag("--serial", a->serial,
                "sequences: read, filter and write one frame after the other (by default the next frame is read and "
                "the last written while one is filtered: faster, three frames in memory instead of one)");
+  app.add_option("--max-memory", a->max_memory,
+                 "one frame in bands of rows, sized to stay under MB megabytes (like OIDN's maxMemoryMB): only the "
+                 "passes the filter reads are decoded, a band at a time; the same pixels as the whole frame")
+      ->check(CLI::Range(1, 1 << 24));
+  app.add_option("--band-rows", a->band_rows, "one frame in bands of N rows (a multiple of 64; see --max-memory)")
+      ->check(CLI::Range(1, 1 << 24));
   app.add_flag("--timings", a->timings, "print read / filter / write times per frame");
   app.add_flag("-v,--verbose", a->verbose, "timings plus the filter's notes");
   return [a] { return run_denoise(*a); };

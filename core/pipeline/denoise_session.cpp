@@ -4,9 +4,11 @@
 #include <future>
 #include <memory>
 
+#include "io/band_reader.h"
 #include "io/exr_output.h"
 #include "io/output_guard.h"
 #include "pipeline/sequence_plan.h"
+#include "pipeline/tiled_run.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -91,6 +93,60 @@ StageTimes DenoiseSession::run(const std::string& input, const std::string& outp
     f.times.write_ms = ms_since(t0);
   }
   return f.times;
+}
+
+StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::string& output, const ReadOptions& read,
+                                        const WriteOptions& write, const ExecOptions& exec, int band_rows, double max_bytes,
+                                        const std::function<void(int, int)>& progress) {
+  const std::string what = band_rows > 0 ? "--band-rows" : "--max-memory";
+  auto refuse = [&](const std::string& why) { throw Error(Errc::InvalidArgument, what + ": " + why); };
+  Filter& filter = reconstruction_.filter();
+  if (reconstruction_.temporal()) refuse("a temporal run (history between frames) is not cut into bands");
+  if (reconstruction_.light_passes()) refuse("components=light_passes filters every light pass whole");
+  if (!(exec.roi == Roi{})) refuse("--region filters part of the frame; bands filter all of it");
+  if (write.keep_passes || write.keep_components) refuse("--keep-passes and --keep-components write every pass whole");
+  if (filter.band_halo() < 0) refuse("filter '" + filter.info().name + "': " + filter.why_not_tileable());
+  if (!output.empty()) {
+    check_output_path(output, {input});
+    check_write(output, write);
+  }
+  StageTimes t;
+  const auto t0 = std::chrono::steady_clock::now();
+  PassNeeds needs = filter.needs();
+  std::vector<Role> roles = needs.required;
+  roles.insert(roles.end(), needs.optional.begin(), needs.optional.end());
+  roles.push_back(Role::Alpha);  // the output's
+  FileBands source(input, read, roles);
+  check_passes(needs, source.layout(), "filter '" + filter.info().name + "'");
+  TiledOptions o;
+  o.nthreads = exec.nthreads;
+  o.band_rows = band_rows > 0 ? band_rows
+                              : band_rows_for(filter, source.width(), source.height(), source.kept_channels(), max_bytes);
+  o.progress = progress;
+  o.keep = {Role::Alpha};
+  Filtered f;
+  f.frame = source.layout().header(source.width(), source.height());
+  f.frame.window = source.layout().window;
+  std::vector<std::string> notes;
+  f.result = run_tiled(filter, source, o, &notes, &f.frame);
+  const BandPlan plan = plan_bands(source.height(), o.band_rows, filter.band_halo());
+  notes.insert(notes.begin(), std::to_string(plan.bands) + " bands of " + std::to_string(plan.band_rows) + " rows (halo " +
+                                  std::to_string(plan.halo) + "), " + std::to_string(source.kept_channels()) + " of " +
+                                  std::to_string(source.file_channels()) + " channels kept");
+  if (filter.measured_holes())
+    notes.push_back(std::to_string(filter.measured_holes()) +
+                    " unsampled pixels filled by each band's own pull-push (not the whole frame's: those pixels may differ)");
+  t.filter_ms = ms_since(t0);  // reading is interleaved with filtering: counted here
+  t.notes = std::move(notes);
+  f.attributes = {{"mcreconFilter", filter.info().name},
+                  {"mcreconParameters", reconstruction_.parameters_text()},
+                  {"mcreconInput", input_stamp(input)}};
+  if (!output.empty()) {
+    const auto t1 = std::chrono::steady_clock::now();
+    write_filtered(output, f, write);
+    t.write_ms = ms_since(t1);
+  }
+  return t;
 }
 
 void DenoiseSession::run_sequence(const std::vector<Job>& jobs, const WriteOptions& write, const ExecOptions& exec,

@@ -39,6 +39,16 @@ class DenoiseSession {
   StageTimes run(const std::string& input, const std::string& output, const ReadOptions& read,
                  const WriteOptions& write, const ExecOptions& exec);
 
+  // run() of one frame in bands of rows (pipeline/tiled_run.h): the same pixels, in bounded
+  // memory; only the passes the filter reads are decoded, a band at a time. band_rows > 0
+  // sets the band height; else max_bytes (> 0) chooses it (band_rows_for). progress(done,
+  // all) after each band of each pass. Throws InvalidArgument, naming the option, for what
+  // bands cannot do: a temporal run, components=light_passes, a region, --keep-passes,
+  // --keep-components, a deep or multi-part file, loose pass files, half buffers, foveation.
+  StageTimes run_in_bands(const std::string& input, const std::string& output, const ReadOptions& read,
+                          const WriteOptions& write, const ExecOptions& exec, int band_rows, double max_bytes,
+                          const std::function<void(int, int)>& progress);
+
   // A sequence of run()s. pipelined: frame i+1 is read and frame i-1 written while frame i
   // is filtered (three frames in memory instead of one; the same outputs, in order). An
   // error stops the run after the write in flight has finished: every output written is

@@ -38,6 +38,38 @@ BandPlan plan_bands(int height, int band_rows, int halo) {
   return p;
 }
 
+double band_bytes_per_pixel(const Filter& filter, int input_channels) {
+  // The filter's working planes per pixel of a band (the preparation's colour copies and
+  // divisor, the filter's own planes and scratch), measured as peak RSS over the band's
+  // pixels on 4096-wide bands (README, "Huge frames"), rounded up.
+  const std::string& f = filter.info().name;
+  const double work = f == "box" || f == "gaussian" ? 64 : f == "bilateral" ? 192 : f == "atrous" ? 160
+                      : f == "guided" ? 256 : f == "pwaf" ? 192 : 256;
+  return 4.0 * input_channels + work;  // the band's passes as read
+}
+
+int band_rows_for(const Filter& filter, int width, int height, int input_channels, double max_bytes) {
+  const double px = double(width) * double(height);
+  // Held for the whole frame: the result (RGB float) and the alpha; then either the
+  // statistics pass's values (pwaf: its spacing pairs and relative variance, three doubles a
+  // pixel; guided: two noise values) or, at the end, the writer's interleaved copy and its
+  // buffer (RGBA float, twice).
+  const std::string& f = filter.info().name;
+  const double stats = f == "pwaf" ? 24.0 : f == "guided" ? 16.0 : 0.0;
+  // The band and the statistics are held together; the writer comes after both are freed.
+  const double whole = px * (12.0 + 4.0 + stats);
+  const double per_row = double(width) * band_bytes_per_pixel(filter, input_channels);
+  const double halo_rows = 2.0 * (filter.band_halo() + kBandAlign);
+  const double rows = (max_bytes - whole) / per_row - halo_rows;
+  if (!(rows >= kBandAlign) || px * (12.0 + 4.0 + 32.0) > max_bytes)
+    throw Error(Errc::InvalidArgument,
+                "--max-memory " + std::to_string(int(max_bytes / (1024.0 * 1024.0))) + " MB is too little for a " +
+                    std::to_string(width) + "x" + std::to_string(height) + " frame with filter '" + filter.info().name +
+                    "': at least " + std::to_string(int((whole + per_row * (halo_rows + kBandAlign)) / (1024.0 * 1024.0)) + 1) +
+                    " MB");
+  return int(std::min(rows, double(std::max(height, kBandAlign)))) / kBandAlign * kBandAlign;
+}
+
 namespace {
 
 void add_notes(const std::vector<std::string>& from, std::vector<std::string>& to) {
@@ -47,7 +79,8 @@ void add_notes(const std::vector<std::string>& from, std::vector<std::string>& t
 
 }  // namespace
 
-Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes) {
+Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes,
+                Frame* kept) {
   const int halo = filter.band_halo(), margin = filter.band_margin();
   if (halo < 0)
     throw Error(Errc::InvalidArgument, "filter '" + filter.info().name + "' cannot run in bands under these settings (" +
@@ -64,6 +97,11 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
     return std::make_pair(r0, r1);
   };
 
+  int step = 0, passes = 1;
+  auto stepped = [&] {
+    ++step;
+    if (options.progress) options.progress(step, (passes + 1) * plan.bands);
+  };
   filter.begin_statistics();
   try {
     do {
@@ -73,8 +111,11 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
         Frame band = source.rows(r0, r1);
         filter.attach_statistics(band);
         filter.measure(band, rows, options.nthreads);
+        stepped();
       }
+      ++passes;
     } while (filter.end_statistics_pass());
+    --passes;
   } catch (...) {
     filter.drop_statistics();
     throw;
@@ -93,8 +134,16 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
       const Image part = filter.execute(band, eo);
       const std::size_t row = std::size_t(w) * 3;
       std::memcpy(out.pixel(0, r0 + rows.y0), part.pixel(0, rows.y0), row * std::size_t(rows.height()) * sizeof(float));
+      if (kept)
+        for (Role r : options.keep)
+          if (const Pass* p = band.find(r)) {
+            auto k = std::find_if(kept->passes.begin(), kept->passes.end(), [&](const Pass& q) { return q.role == r; });
+            if (k == kept->passes.end()) k = kept->passes.insert(kept->passes.end(), with_pixels(*p, Image(w, h, p->image.channels())));
+            const std::size_t kr = std::size_t(w) * std::size_t(p->image.channels());
+            std::memcpy(k->image.pixel(0, r0 + rows.y0), p->image.pixel(0, rows.y0), kr * std::size_t(rows.height()) * sizeof(float));
+          }
       add_notes(filter.notes(), said);
-      if (options.progress) options.progress(b + 1, plan.bands);
+      stepped();
     }
   } catch (...) {
     filter.drop_statistics();

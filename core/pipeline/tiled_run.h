@@ -68,13 +68,16 @@ int band_rows_for(const Filter& filter, int width, int height, int input_channel
 struct TiledOptions {
   int band_rows = 0;  // from plan_bands / band_rows_for
   int nthreads = 0;
-  // Called after each band filtered: (bands done, bands in all).
+  // Called after each band measured or filtered: (steps done, steps in all).
   std::function<void(int, int)> progress;
+  // Passes whose rows the run gathers into `kept` (full size), e.g. the alpha for the output.
+  std::vector<Role> keep;
 };
 
 // The filter (committed, tileable: band_halo() >= 0) over every band of `source`: its RGB
 // result, equal to filter.execute() on the whole frame. `notes`: the filter's notes, each
 // once (the statistics pass's first, then the bands').
-Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes = nullptr);
+Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes = nullptr,
+                Frame* kept = nullptr);
 
 }  // namespace mcr

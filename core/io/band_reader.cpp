@@ -1,0 +1,127 @@
+#include "io/band_reader.h"
+
+#include <OpenImageIO/imageio.h>
+
+#include <algorithm>
+#include <cstring>
+
+#include "io/input_limits.h"
+#include "io/spec_window.h"
+#include "util/error.h"
+#include "util/parallel.h"
+
+OIIO_NAMESPACE_USING
+
+namespace mcr {
+
+namespace {
+
+constexpr int kChunkRows = 32;  // rows decoded at a time (two zip blocks of 16)
+
+std::unique_ptr<ImageInput> open_for_bands(const std::string& path, std::string& why) {
+  check_image_file(path);  // FileNotFound, NotAnImage, a header its bytes cannot back
+  auto in = ImageInput::open(path);
+  if (!in) throw Error(Errc::ReadFailed, "cannot read '" + path + "': " + OIIO::geterror());
+  const ImageSpec& spec = in->spec();
+  if (spec.deep) why = "it is a deep file";
+  else if (in->seek_subimage(1, 0)) why = "it has several parts";
+  else if (spec.depth > 1) why = "it is a volume";
+  in->seek_subimage(0, 0);
+  return in;
+}
+
+}  // namespace
+
+std::string why_not_bands(const std::string& path, const ReadOptions& options) {
+  if (!options.second_half.empty()) return "the frame is the mean of two half buffers";
+  if (!loose_pass_files(options).empty()) return "a pass comes from another file (--pass ROLE=FILE)";
+  std::string why;
+  open_for_bands(path, why);
+  return why;
+}
+
+struct FileBands::Impl {
+  std::string path;
+  std::unique_ptr<ImageInput> in;
+  ImageSpec spec;
+  Frame layout;
+  // Per kept pass: the file channel of each of its image's channels.
+  std::vector<std::vector<int>> sources;
+};
+
+FileBands::FileBands(const std::string& path, const ReadOptions& options, const std::vector<Role>& roles)
+    : impl_(std::make_unique<Impl>()) {
+  Impl& m = *impl_;
+  m.path = path;
+  const std::string why = why_not_bands(path, options);
+  if (!why.empty()) throw Error(Errc::InvalidArgument, "'" + path + "' cannot be read in bands: " + why);
+  std::string ignored;
+  m.in = open_for_bands(path, ignored);
+  m.spec = m.in->spec();
+  const int nch = m.spec.nchannels;
+  std::vector<std::string> names(m.spec.channelnames.begin(), m.spec.channelnames.end());
+  // The passes as read_frame chooses them, from one row of zeros: names and roles only.
+  ReadOptions layout_options = options;
+  layout_options.keep_extra = false;
+  Frame all = frame_from_channels(path, m.spec.width, 1, names, std::vector<float>(std::size_t(m.spec.width) * nch, 0.0f),
+                                  layout_options);
+  m.layout = all.header(m.spec.width, 1);
+  m.layout.window = window_of(m.spec);
+  for (Pass& p : all.passes) {
+    const bool keep = p.role == Role::Colour || std::find(roles.begin(), roles.end(), p.role) != roles.end();
+    if (!keep) continue;
+    std::vector<int> src;
+    for (const std::string& c : p.channels) {
+      const auto it = std::find(names.begin(), names.end(), c);
+      if (it == names.end()) throw Error(Errc::Internal, "band reader: channel '" + c + "' not in '" + path + "'");
+      src.push_back(int(it - names.begin()));
+    }
+    if (int(src.size()) != p.image.channels())
+      throw Error(Errc::Internal, "band reader: pass '" + p.name + "' of '" + path + "' has another channel count");
+    m.sources.push_back(std::move(src));
+    m.layout.passes.push_back(std::move(p));
+  }
+}
+
+FileBands::~FileBands() = default;
+
+int FileBands::width() const { return impl_->spec.width; }
+int FileBands::height() const { return impl_->spec.height; }
+int FileBands::file_channels() const { return impl_->spec.nchannels; }
+int FileBands::kept_channels() const {
+  int n = 0;
+  for (const Pass& p : impl_->layout.passes) n += p.image.channels();
+  return n;
+}
+const Frame& FileBands::layout() const { return impl_->layout; }
+
+Frame FileBands::rows(int y0, int y1) {
+  Impl& m = *impl_;
+  const int w = m.spec.width, nch = m.spec.nchannels;
+  if (y0 < 0 || y1 > m.spec.height || y0 >= y1)
+    throw Error(Errc::Internal, "band reader: rows " + std::to_string(y0) + ".." + std::to_string(y1) + " outside '" + m.path + "'");
+  Frame f = m.layout.header(w, y1 - y0);
+  f.window = m.layout.window;
+  for (const Pass& p : m.layout.passes) f.passes.push_back(with_pixels(p, Image(w, y1 - y0, p.image.channels())));
+  std::vector<float> chunk(std::size_t(w) * std::size_t(nch) * kChunkRows);
+  for (int c0 = y0; c0 < y1; c0 += kChunkRows) {
+    const int c1 = std::min(y1, c0 + kChunkRows);
+    if (!m.in->read_scanlines(0, 0, m.spec.y + c0, m.spec.y + c1, 0, 0, nch, TypeDesc::FLOAT, chunk.data()))
+      throw Error(Errc::ReadFailed, "cannot read rows " + std::to_string(c0) + ".." + std::to_string(c1) + " of '" + m.path +
+                                        "': " + m.in->geterror());
+    for (std::size_t k = 0; k < f.passes.size(); ++k) {
+      Image& im = f.passes[k].image;
+      const std::vector<int>& src = m.sources[k];
+      const int pc = im.channels();
+      parallel_rows(c0, c1, 0, [&](int y) {
+        const float* s = chunk.data() + std::size_t(y - c0) * std::size_t(w) * std::size_t(nch);
+        float* d = im.pixel(0, y - y0);
+        for (int x = 0; x < w; ++x)
+          for (int c = 0; c < pc; ++c) d[std::size_t(x) * pc + c] = s[std::size_t(x) * nch + src[std::size_t(c)]];
+      });
+    }
+  }
+  return f;
+}
+
+}  // namespace mcr

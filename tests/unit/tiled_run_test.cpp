@@ -1,0 +1,126 @@
+// Tiled runs (pipeline/tiled_run.h): a frame in bands of rows gives the whole frame's pixels,
+// bit for bit; the oracle is the filter's own whole-frame execute().
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstring>
+#include <random>
+#include <string>
+
+#include "io/band_reader.h"
+#include "io/frame_reader.h"
+#include "kernels/feature_activity.h"
+#include "pipeline/reconstruction.h"
+#include "pipeline/tiled_run.h"
+
+namespace mcr {
+namespace {
+
+std::string sample(const std::string& scene) {
+  return std::string(MCRECON_SOURCE_DIR) + "/samples/data/" + scene + "/" + scene + "_16spp.exr";
+}
+
+// Values that differ bit for bit.
+long differing(const Image& a, const Image& b) {
+  long n = 0;
+  for (int y = 0; y < a.height(); ++y)
+    for (int x = 0; x < a.width(); ++x)
+      for (int c = 0; c < 3; ++c) {
+        const float u = a.at(x, y, c), v = b.at(x, y, c);
+        n += std::memcmp(&u, &v, sizeof u) != 0;
+      }
+  return n;
+}
+
+class TiledRunTest : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(TiledRunTest, BandsGiveTheWholeFramesPixels) {
+  for (const char* scene : {"room", "sunlit"}) {
+    const Frame frame = read_frame(sample(scene));
+    auto filter = make_committed_filter(GetParam(), {});
+    const Image whole = filter->execute(frame);
+    FrameRows rows(frame);
+    TiledOptions o;
+    o.band_rows = 64;  // three bands of the 192 rows
+    const Image tiled = run_tiled(*filter, rows, o);
+    EXPECT_EQ(differing(whole, tiled), 0) << scene;
+  }
+}
+
+// The normal pass constant over everything the first band reads (its rows and halo), varying
+// below: the band alone would drop its weight (kernels/feature_activity.h); the frame's
+// spread keeps it.
+TEST_P(TiledRunTest, APassConstantInOneBandIsJudgedOverTheFrame) {
+  Frame frame = read_frame(sample("room"));
+  auto probe = make_committed_filter(GetParam(), {});
+  const int constant_rows = std::min(frame.height - 2, 64 + probe->band_halo());
+  for (Pass& p : frame.passes)
+    if (p.role == Role::Normal)
+      for (int y = 0; y < constant_rows; ++y)
+        for (int x = 0; x < frame.width; ++x)
+          for (int c = 0; c < p.image.channels(); ++c) p.image.at(x, y, c) = c == 2 ? 1.0f : 0.0f;
+  auto filter = make_committed_filter(GetParam(), {});
+  const Image whole = filter->execute(frame);
+  FrameRows rows(frame);
+  TiledOptions o;
+  o.band_rows = 64;
+  EXPECT_EQ(differing(whole, run_tiled(*filter, rows, o)), 0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Filters, TiledRunTest,
+                         ::testing::Values("box", "gaussian", "bilateral", "atrous", "guided", "pwaf"));
+
+TEST(TiledRun, ActivityOverTheFrameAnswersAsTheScan) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-1e-3f, 1e-3f);
+  for (int trial = 0; trial < 40; ++trial) {
+    Image im(23, 17, 3);
+    const float spread = trial % 4 == 0 ? 0.0f : trial % 4 == 1 ? 1e-5f : 1.0f;
+    for (int y = 0; y < 17; ++y)
+      for (int x = 0; x < 23; ++x)
+        for (int c = 0; c < 3; ++c) im.at(x, y, c) = 0.5f + spread * u(rng) * 1000.0f;
+    if (trial % 5 == 0) im.at(3, 4, 1) = std::numeric_limits<float>::quiet_NaN();
+    if (trial % 7 == 0) im.at(0, 0, 0) = std::numeric_limits<float>::infinity();
+    WholeFrameRange r;
+    for (int y0 = 0; y0 < 17; y0 += 5) extend_frame_range(im, 3, Roi{0, y0, 23, std::min(17, y0 + 5)}, r);
+    for (double tol : {0.0, 1e-6, 1e-3, 1.0}) {
+      const FeatureActivity scan = feature_activity(im, 3, Roi::all(23, 17), tol, 1);
+      const FeatureActivity frame = activity_over_frame(r, tol);
+      EXPECT_EQ(int(scan.kind), int(frame.kind)) << trial << " " << tol;
+      if (scan.kind == Activity::Constant) {
+        EXPECT_EQ(scan.some_nonfinite, frame.some_nonfinite);
+        for (int c = 0; c < 3; ++c) EXPECT_EQ(scan.value[c], frame.value[c]);
+      }
+    }
+  }
+}
+
+TEST(TiledRun, AFilesBandsHoldItsRows) {
+  const std::string path = sample("glossy");
+  const Frame frame = read_frame(path);
+  FileBands bands(path, {}, {Role::Normal, Role::Albedo, Role::Depth});
+  EXPECT_EQ(bands.width(), frame.width);
+  EXPECT_EQ(bands.height(), frame.height);
+  const Frame part = bands.rows(37, 101);
+  ASSERT_EQ(part.height, 64);
+  for (Role r : {Role::Colour, Role::Normal, Role::Albedo, Role::Depth}) {
+    const Image& a = part.image(r);
+    const Image& b = frame.image(r);
+    ASSERT_EQ(a.channels(), b.channels()) << role_name(r);
+    EXPECT_EQ(std::memcmp(a.data(), b.pixel(0, 37), sizeof(float) * std::size_t(a.width()) * 64 * std::size_t(a.channels())), 0)
+        << role_name(r);
+  }
+  EXPECT_FALSE(part.has(Role::Position));  // not asked for: not decoded
+  EXPECT_LT(bands.kept_channels(), bands.file_channels());
+}
+
+TEST(TiledRun, BandsAreAlignedAndCoverTheFrame) {
+  const BandPlan p = plan_bands(3072, 100, 59);
+  EXPECT_EQ(p.band_rows, 128);
+  EXPECT_EQ(p.bands, 24);
+  EXPECT_EQ(plan_bands(50, 64, 10).band_rows, 50);
+  EXPECT_EQ(plan_bands(50, 64, 10).bands, 1);
+}
+
+}  // namespace
+}  // namespace mcr
