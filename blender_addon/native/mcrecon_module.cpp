@@ -393,7 +393,7 @@ class Session {
 
   py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,
                         const py::dict& passes, bool keep_passes, bool keep_components = false,
-                        const py::object& display = py::none()) {
+                        const py::object& display = py::none(), int max_memory_mb = 0) {
     const mcr::ReadOptions ro = read_options(layer, passes);
     const mcr::WriteOptions wo = write_options(keep_passes, keep_components, display);
     mcr::ReadOptions r = ro;
@@ -402,10 +402,14 @@ class Session {
     mcr::StageTimes t;
     {
       py::gil_scoped_release release;
-      t = session_.run(input, output, r, wo, eo);
+      t = max_memory_mb > 0 ? session_.run_in_bands(input, output, r, wo, eo, 0, double(max_memory_mb) * 1024.0 * 1024.0, {})
+                            : session_.run(input, output, r, wo, eo);
     }
     py::dict d = times_dict(t);
-    d["notes"] = notes();  // what auto chose and scored, unused settings: mcrecon.denoise_file keeps no Session
+    // What auto chose and scored, unused settings: mcrecon.denoise_file keeps no Session. In
+    // bands: the bands, then every band's notes once.
+    if (max_memory_mb > 0) d["notes"] = t.notes;
+    else d["notes"] = notes();
     return d;
   }
 
@@ -501,11 +505,12 @@ PYBIND11_MODULE(mcrecon, m) {
           "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them).")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
-           py::arg("display") = py::none(),
+           py::arg("display") = py::none(), py::arg("max_memory_mb") = 0,
            "Reads a render (multilayer EXR), filters it and writes output (temp + rename) in the format its "
            "extension names (.exr; .png, .jpg, .tif through the OpenColorIO view in display=, e.g. "
            "{'view': 'Filmic', 'exposure': 0.5}); returns stage timings "
-           "and the notes (as notes()). "
+           "and the notes (as notes()). max_memory_mb > 0: the frame in bands of rows under that many MB, "
+           "the same pixels (as --max-memory). "
            "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}. keep_components=True "
            "(with params components='light_passes'): each denoised light component as its own layer, as "
            "--keep-components.");
@@ -535,14 +540,14 @@ PYBIND11_MODULE(mcrecon, m) {
       "denoise_file",
       [](const std::string& input, const std::string& output, const std::string& filter, const py::dict& params,
          const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads,
-         const py::object& accumulate, bool keep_components, const py::object& display) {
+         const py::object& accumulate, bool keep_components, const py::object& display, int max_memory_mb) {
         Session s(filter, params, threads, accumulate);
-        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components, display);
+        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components, display, max_memory_mb);
       },
       py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
       py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
       py::arg("threads") = 0, py::arg("accumulate") = false, py::arg("keep_components") = false,
-      py::arg("display") = py::none(),
+      py::arg("display") = py::none(), py::arg("max_memory_mb") = 0,
       "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate; "
       "keep_components=True: --keep-components, with params={'components': 'light_passes'}; display={'view': "
       "'Filmic', 'look': ..., 'exposure': ..., 'gamma': ..., 'bit_depth': 8 or 16}: --view etc. for a "

@@ -93,6 +93,8 @@ class Filter {
   // Rows around a band's own that execute() must filter too (the step back's windows read
   // the filtered result around each pixel).
   int band_margin() const;
+  // Rows a band's first row must be a multiple of (grids its estimates lie on): a multiple of 64.
+  virtual int band_alignment() const { return 64; }
   // The statistics passes: begin_statistics(); then, while end_statistics_pass() says another
   // is needed, attach_statistics() and measure() on every band in frame order (`rows`: the
   // band's own rows, in its coordinates); then attach_statistics() on each band before its

@@ -47,6 +47,10 @@ struct FileBands::Impl {
   Frame layout;
   // Per kept pass: the file channel of each of its image's channels.
   std::vector<std::vector<int>> sources;
+  // The last band given: bands in order overlap by their halos, whose rows are copied from
+  // it instead of decoded again.
+  Frame last;  // its last rows only: [last_y0, last_y1)
+  int last_y0 = 0, last_y1 = 0, keep = 0;
 };
 
 FileBands::FileBands(const std::string& path, const ReadOptions& options, const std::vector<Role>& roles)
@@ -85,6 +89,8 @@ FileBands::FileBands(const std::string& path, const ReadOptions& options, const 
 
 FileBands::~FileBands() = default;
 
+void FileBands::overlap_hint(int rows) { impl_->keep = std::max(0, rows); }
+
 int FileBands::width() const { return impl_->spec.width; }
 int FileBands::height() const { return impl_->spec.height; }
 int FileBands::file_channels() const { return impl_->spec.nchannels; }
@@ -103,8 +109,19 @@ Frame FileBands::rows(int y0, int y1) {
   Frame f = m.layout.header(w, y1 - y0);
   f.window = m.layout.window;
   for (const Pass& p : m.layout.passes) f.passes.push_back(with_pixels(p, Image(w, y1 - y0, p.image.channels())));
+  // Rows the last band holds (the overlap at the top of this one): copied.
+  int from = y0;
+  if (m.last_y1 > y0 && m.last_y0 <= y0) {
+    const int c1 = std::min(y1, m.last_y1);
+    for (std::size_t k = 0; k < f.passes.size(); ++k) {
+      Image& im = f.passes[k].image;
+      const std::size_t row = std::size_t(w) * std::size_t(im.channels());
+      std::memcpy(im.pixel(0, 0), m.last.passes[k].image.pixel(0, y0 - m.last_y0), row * std::size_t(c1 - y0) * sizeof(float));
+    }
+    from = c1;
+  }
   std::vector<float> chunk(std::size_t(w) * std::size_t(nch) * kChunkRows);
-  for (int c0 = y0; c0 < y1; c0 += kChunkRows) {
+  for (int c0 = from; c0 < y1; c0 += kChunkRows) {
     const int c1 = std::min(y1, c0 + kChunkRows);
     if (!m.in->read_scanlines(0, 0, m.spec.y + c0, m.spec.y + c1, 0, 0, nch, TypeDesc::FLOAT, chunk.data()))
       throw Error(Errc::ReadFailed, "cannot read rows " + std::to_string(c0) + ".." + std::to_string(c1) + " of '" + m.path +
@@ -120,6 +137,16 @@ Frame FileBands::rows(int y0, int y1) {
           for (int c = 0; c < pc; ++c) d[std::size_t(x) * pc + c] = s[std::size_t(x) * nch + src[std::size_t(c)]];
       });
     }
+  }
+  // The rows the next band may share, copied: the caller's band may be changed.
+  m.last_y1 = y1;
+  m.last_y0 = std::max(y0, y1 - m.keep);
+  m.last = f.header(w, m.last_y1 - m.last_y0);
+  for (const Pass& p : f.passes) {
+    Image tail(w, m.last_y1 - m.last_y0, p.image.channels());
+    const std::size_t row = std::size_t(w) * std::size_t(p.image.channels());
+    if (tail.height() > 0) std::memcpy(tail.data(), p.image.pixel(0, m.last_y0 - y0), row * std::size_t(tail.height()) * sizeof(float));
+    m.last.passes.push_back(with_pixels(p, std::move(tail)));
   }
   return f;
 }

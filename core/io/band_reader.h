@@ -23,6 +23,7 @@ class FileBands : public BandSource {
   int width() const override;
   int height() const override;
   Frame rows(int y0, int y1) override;
+  void overlap_hint(int rows) override;
   // Channels decoded per pixel (the file's) and kept per pixel (the passes kept).
   int file_channels() const;
   int kept_channels() const;

@@ -137,7 +137,6 @@ void write_result(const std::string& path, const Image& rgb, const Frame& input,
   spec.attribute("Software", "mcrecon");
   for (const auto& kv : options.attributes) spec.attribute(kv.first, kv.second);
 
-  ImageBuf buf(spec);
   std::vector<float> pixels(std::size_t(input.width) * input.height * nc);
   const std::size_t n = std::size_t(input.width) * input.height;
   for (int c = 0; c < nc; ++c) {
@@ -150,7 +149,7 @@ void write_result(const std::string& path, const Image& rgb, const Frame& input,
     const float* d = s.image->data();
     for (std::size_t i = 0; i < n; ++i) pixels[i * nc + c] = d[i * sc + s.channel];
   }
-  buf.set_pixels(buf.roi(), TypeFloat, pixels.data());
+  const ImageBuf buf(spec, pixels.data());  // wraps the pixels: no second copy of a huge frame
   write_atomic(buf, path, "openexr");
 }
 

@@ -1,6 +1,9 @@
 #include "pipeline/denoise_session.h"
 
 #include <chrono>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <future>
 #include <memory>
 
@@ -14,6 +17,17 @@
 namespace mcr {
 
 namespace {
+
+// A bounded-memory run frees each band's buffers before the next: they must go back to the
+// system. glibc serves an allocation from its heap once a freed mapping of that size raised
+// its mmap threshold, and a heap rarely shrinks: band buffers (megabytes each) then pile up.
+// A fixed threshold keeps every large buffer a mapping of its own.
+void release_freed_memory() {
+#ifdef __GLIBC__
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+#endif
+}
+
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -110,6 +124,7 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
     check_output_path(output, {input});
     check_write(output, write);
   }
+  release_freed_memory();
   StageTimes t;
   const auto t0 = std::chrono::steady_clock::now();
   PassNeeds needs = filter.needs();
@@ -130,7 +145,7 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   std::vector<std::string> notes;
   f.result = run_tiled(filter, source, o, &notes, &f.frame);
   const BandPlan plan = plan_bands(source.height(), o.band_rows, filter.band_halo());
-  notes.insert(notes.begin(), std::to_string(plan.bands) + " bands of " + std::to_string(plan.band_rows) + " rows (halo " +
+  notes.insert(notes.begin(), std::to_string(plan.bands) + (plan.bands == 1 ? " band of " : " bands of ") + std::to_string(plan.band_rows) + " rows (halo " +
                                   std::to_string(plan.halo) + "), " + std::to_string(source.kept_channels()) + " of " +
                                   std::to_string(source.file_channels()) + " channels kept");
   if (filter.measured_holes())

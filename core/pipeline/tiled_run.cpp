@@ -40,11 +40,11 @@ BandPlan plan_bands(int height, int band_rows, int halo) {
 
 double band_bytes_per_pixel(const Filter& filter, int input_channels) {
   // The filter's working planes per pixel of a band (the preparation's colour copies and
-  // divisor, the filter's own planes and scratch), measured as peak RSS over the band's
-  // pixels on 4096-wide bands (README, "Huge frames"), rounded up.
+  // divisor, the filter's own planes and scratch): peak RSS less what the run holds besides,
+  // over the band's pixels, on a 4096x3072 frame (README, "Huge frames"), plus a tenth.
   const std::string& f = filter.info().name;
-  const double work = f == "box" || f == "gaussian" ? 64 : f == "bilateral" ? 192 : f == "atrous" ? 160
-                      : f == "guided" ? 256 : f == "pwaf" ? 192 : 256;
+  const double work = f == "box" ? 144 : f == "gaussian" ? 184 : f == "bilateral" ? 192 : f == "atrous" ? 208
+                      : f == "guided" ? 192 : f == "pwaf" ? 200 : 224;
   return 4.0 * input_channels + work;  // the band's passes as read
 }
 
@@ -57,15 +57,18 @@ int band_rows_for(const Filter& filter, int width, int height, int input_channel
   const std::string& f = filter.info().name;
   const double stats = f == "pwaf" ? 24.0 : f == "guided" ? 16.0 : 0.0;
   // The band and the statistics are held together; the writer comes after both are freed.
-  const double whole = px * (12.0 + 4.0 + stats);
+  constexpr double kProcess = 160.0 * 1024 * 1024;  // the process itself (code, libraries, thread stacks)
+  const double whole = kProcess + px * (12.0 + 4.0 + stats);
   const double per_row = double(width) * band_bytes_per_pixel(filter, input_channels);
-  const double halo_rows = 2.0 * (filter.band_halo() + kBandAlign);
-  const double rows = (max_bytes - whole) / per_row - halo_rows;
-  if (!(rows >= kBandAlign) || px * (12.0 + 4.0 + 32.0) > max_bytes)
+  const double halo_rows = 2.0 * (filter.band_halo() + std::max(kBandAlign, filter.band_alignment()));
+  // A file source keeps the rows consecutive bands share (io/band_reader.h).
+  const double overlap = halo_rows * double(width) * 4.0 * input_channels;
+  const double rows = (max_bytes - whole - overlap) / per_row - halo_rows;
+  if (!(rows >= kBandAlign) || kProcess + px * (12.0 + 4.0 + 32.0) > max_bytes)
     throw Error(Errc::InvalidArgument,
                 "--max-memory " + std::to_string(int(max_bytes / (1024.0 * 1024.0))) + " MB is too little for a " +
                     std::to_string(width) + "x" + std::to_string(height) + " frame with filter '" + filter.info().name +
-                    "': at least " + std::to_string(int((whole + per_row * (halo_rows + kBandAlign)) / (1024.0 * 1024.0)) + 1) +
+                    "': at least " + std::to_string(int((whole + overlap + per_row * (halo_rows + kBandAlign)) / (1024.0 * 1024.0)) + 1) +
                     " MB");
   return int(std::min(rows, double(std::max(height, kBandAlign)))) / kBandAlign * kBandAlign;
 }
@@ -87,11 +90,13 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
                                            filter.why_not_tileable() + ")");
   const int w = source.width(), h = source.height();
   const BandPlan plan = plan_bands(h, options.band_rows, halo);
+  source.overlap_hint(2 * plan.halo + std::max(kBandAlign, filter.band_alignment()));
   std::vector<std::string> said;
+  const int align = std::max(kBandAlign, filter.band_alignment());
   auto band_of = [&](int b, Roi& rows) {
     const int y0 = b * plan.band_rows, y1 = std::min(h, y0 + plan.band_rows);
     // The halo rounded out to whole alignment steps: a band's frame starts on the grid too.
-    const int r0 = std::max(0, (y0 - plan.halo) / kBandAlign * kBandAlign);
+    const int r0 = std::max(0, (y0 - plan.halo) / align * align);
     const int r1 = std::min(h, y1 + plan.halo);
     rows = Roi{0, y0 - r0, w, y1 - r0};
     return std::make_pair(r0, r1);

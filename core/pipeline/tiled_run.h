@@ -29,6 +29,8 @@ class BandSource {
   virtual int height() const = 0;
   // Rows [y0, y1) of the frame as a frame of width() x (y1 - y0): every pass the run reads.
   virtual Frame rows(int y0, int y1) = 0;
+  // Consecutive bands share up to this many rows (their halos): a source may keep them.
+  virtual void overlap_hint(int rows) { (void)rows; }
 };
 
 // The rows of a frame in memory.

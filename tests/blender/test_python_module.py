@@ -314,6 +314,19 @@ def test_gil_released_while_filtering():
     print("GIL released while filtering: another Python thread ran during mcrecon.denoise")
 
 
+def test_bands_match_the_whole_frame(tmp):
+    """denoise_file(max_memory_mb=N) filters in bands of rows, as `--max-memory N`: the whole
+    frame's pixels bit for bit, the bands named in the notes; a temporal run is refused."""
+    whole, banded = os.path.join(tmp, "whole.exr"), os.path.join(tmp, "banded.exr")
+    mcrecon.denoise_file(ROOM, whole, "pwaf")
+    t = mcrecon.denoise_file(ROOM, banded, "pwaf", max_memory_mb=300)
+    assert any(re.match(r"\d+ bands? of \d+ rows", n) for n in t["notes"]), t["notes"]
+    assert np.array_equal(read_channels(whole)[1], read_channels(banded)[1]), "bands differ from the whole frame"
+    expect_error(lambda: mcrecon.denoise_file(ROOM, os.path.join(tmp, "b.exr"), "bmfr", max_memory_mb=300),
+                 "invalid_argument", "temporal")
+    print("max_memory_mb: bands give the whole frame's pixels")
+
+
 def test_display_outputs_match_cli(tmp):
     """denoise_file(display=...) writes what `mcrecon denoise --view ...` writes, bit for bit."""
     for name, args, display in (("s.png", [], None), ("f.tif", ["--view", "Filmic", "--exposure", "0.5"],
@@ -377,5 +390,6 @@ if __name__ == "__main__":
         test_two_threads_filter_at_once()
         test_gil_released_while_filtering()
         test_display_outputs_match_cli(tmp)
+        test_bands_match_the_whole_frame(tmp)
         test_errors(tmp)
     print("OK")

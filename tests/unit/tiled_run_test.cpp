@@ -67,6 +67,29 @@ TEST_P(TiledRunTest, APassConstantInOneBandIsJudgedOverTheFrame) {
   EXPECT_EQ(differing(whole, run_tiled(*filter, rows, o)), 0);
 }
 
+// A frame taller than guided's 256-row sum bands (three copies of a sample's left 96 columns
+// stacked): bands that start off that grid still sum as the whole frame does.
+TEST_P(TiledRunTest, ATallFramesBandsGiveItsPixels) {
+  const Frame one = read_frame(sample("room"));
+  const int w = 96, copies = 3;
+  Frame tall = one.header(w, one.height * copies);
+  for (const Pass& p : one.passes) {
+    Image im(w, one.height * copies, p.image.channels());
+    for (int k = 0; k < copies; ++k)
+      for (int y = 0; y < one.height; ++y)
+        std::memcpy(im.pixel(0, k * one.height + y), p.image.pixel(0, y), sizeof(float) * std::size_t(w) * std::size_t(p.image.channels()));
+    tall.passes.push_back(with_pixels(p, std::move(im)));
+  }
+  auto filter = make_committed_filter(GetParam(), {});
+  const Image whole = filter->execute(tall);
+  FrameRows rows(tall);
+  for (int band_rows : {64, 192}) {
+    TiledOptions o;
+    o.band_rows = band_rows;
+    EXPECT_EQ(differing(whole, run_tiled(*filter, rows, o)), 0) << band_rows << "-row bands";
+  }
+}
+
 INSTANTIATE_TEST_SUITE_P(Filters, TiledRunTest,
                          ::testing::Values("box", "gaussian", "bilateral", "atrous", "guided", "pwaf"));
 
@@ -112,6 +135,23 @@ TEST(TiledRun, AFilesBandsHoldItsRows) {
   }
   EXPECT_FALSE(part.has(Role::Position));  // not asked for: not decoded
   EXPECT_LT(bands.kept_channels(), bands.file_channels());
+}
+
+// Consecutive bands share rows, which the reader copies from the last band instead of
+// decoding them again: the same pixels either way.
+TEST(TiledRun, OverlappingBandsOfAFileHoldItsRows) {
+  const std::string path = sample("glossy");
+  const Frame frame = read_frame(path);
+  FileBands bands(path, {}, {Role::Normal});
+  bands.overlap_hint(50);
+  for (const auto& [y0, y1] : {std::pair<int, int>{0, 80}, {40, 130}, {100, 192}, {0, 64}}) {
+    const Frame part = bands.rows(y0, y1);
+    for (Role r : {Role::Colour, Role::Normal}) {
+      const Image& a = part.image(r);
+      EXPECT_EQ(std::memcmp(a.data(), frame.image(r).pixel(0, y0), sizeof(float) * std::size_t(a.width()) * std::size_t(y1 - y0) * std::size_t(a.channels())), 0)
+          << role_name(r) << " rows " << y0 << ".." << y1;
+    }
+  }
 }
 
 TEST(TiledRun, BandsAreAlignedAndCoverTheFrame) {

@@ -43,6 +43,8 @@ ParamTable with_demodulate_default(ParamTable t) {
 
 }  // namespace
 
+int guided::band_rows(int r) { return std::max(64, (16 * r + 63) / 64 * 64); }
+
 double guided::auto_epsilon(double scale, double median_relative_noise) {
   const double e = scale * median_relative_noise;
   return std::isfinite(e) ? std::clamp(e, 1e-8, 1e6) : 1e6;
@@ -234,8 +236,8 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
   // count): the same sums in the same order on any number of threads. Each band
   // recomputes r coefficient rows past each of its ends, so bands are tall (at
   // least 256 rows and 16r) but at most half the roi, to give two threads work.
-  const int band_h = std::max(256, std::min(16 * c.r, (roi.height() + 1) / 2));
-  st.bands = (roi.height() + band_h - 1) / band_h;
+  const int band_h = guided::band_rows(c.r);
+  st.bands = (roi.y1 - (roi.y0 - roi.y0 % band_h) + band_h - 1) / band_h;
   // The mean colour sums only when some output pixel has no finite guide.
   bool mp = false;
   for (int y = roi.y0; y < roi.y1 && !mp; ++y)

@@ -83,6 +83,10 @@ struct RowStats {
   std::uint32_t hist[256] = {};
 };
 double auto_epsilon(double scale, double median_relative_noise);
+// The rows of the row bands the sums run in (guided_sums.cpp): 16r, at least 64, a multiple
+// of 64 (each band recomputes r coefficient rows past each end), the same for any roi, on the
+// image's grid of that height (a tiled run's bands start on it).
+int band_rows(int r);
 }  // namespace guided
 
 // What the last execute() did, for tests and --verbose tools.
@@ -109,7 +113,12 @@ class GuidedFilter : public Filter {
  protected:
   PassNeeds own_needs() const override;
   std::vector<std::string> own_unused() const override;
-  int own_reach() const override { return 2 * int(params_.get_int("radius")) + 1; }
+  // A band's sums start on the grid line above its first row (up to band_rows - 1 rows up).
+  int own_reach() const override {
+    const int r = int(params_.get_int("radius"));
+    return 2 * r + 1 + guided::band_rows(r);
+  }
+  int band_alignment() const override { return guided::band_rows(int(params_.get_int("radius"))); }
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:

@@ -349,11 +349,15 @@ void run_bands_as(const Ctx& c, const Roi& roi, Image& out, int nthreads, int ba
   const int ox0 = roi.x0, ox1 = roi.x1;
   const std::size_t BK = blocks(std::size_t(kx1 - kx0)), BI = blocks(std::size_t(ix1 - ix0)),
                     BO = blocks(std::size_t(ox1 - ox0));
-  const int nb = (roi.height() + band_h - 1) / band_h;
+  // Bands lie on the image's grid of band_h rows, whatever the roi: a sliding sum's rounding
+  // depends on where it started, so a roi (a tiled run's band of the frame) computes its
+  // first band from the grid line above it (rows before the roi are summed, not written).
+  const int ys = roi.y0 - roi.y0 % band_h;
+  const int nb = (roi.y1 - ys + band_h - 1) / band_h;
   if (work.size() < std::size_t(nb)) work.resize(std::size_t(nb));
 
   parallel_rows(0, nb, nthreads, [&](int band) {
-    const int ya = roi.y0 + band * band_h, yb = std::min(roi.y1, ya + band_h);
+    const int ya = ys + band * band_h, yb = std::min(roi.y1, ya + band_h);
     const int k0 = std::max(0, ya - r), k1 = std::min(H, yb + r);  // coefficient rows
     const std::size_t R = std::size_t(std::min(2 * r + 2, k1 - k0));  // ring of their row sums
     // One allocation per band, kept by the filter between calls (no page faults
@@ -415,6 +419,7 @@ void run_bands_as(const Ctx& c, const Roi& roi, Image& out, int nthreads, int ba
         const int ki = y + r, ko = y - r - 1;
         vertical_step2<D, OUT, MP>(V2, ki < H ? ring_row(ki) : nullptr, ko >= 0 ? ring_row(ko) : nullptr, BO);
       }
+      if (y < roi.y0) return;
       load_guide<D>(c, y, ox0, ox1, G);
       output_row<D, OUT, MP>(V2, G, Q, BO);
       float* o = out.pixel(ox0, y);

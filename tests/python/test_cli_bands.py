@@ -1,0 +1,75 @@
+"""A frame in bands of rows (issue 19: bounded memory on huge frames): `--band-rows` and
+`--max-memory` give the whole-frame run's pixels bit for bit, with the same header, and are
+refused with a message naming the option where bands cannot serve. Oracle: the same filter
+run on the whole frame."""
+import os
+import shutil
+import tempfile
+import unittest
+
+import numpy as np
+import OpenImageIO as oiio
+
+import mcrecon_testutil as tu
+
+ROOM = os.path.join(tu.source_dir(), "samples", "data", "room", "room_16spp.exr")
+ANIM = os.path.join(tu.source_dir(), "samples", "data", "anim", "anim_1spp_####.exr")
+
+
+def image(path):
+    buf = oiio.ImageBuf(path)
+    return buf.get_pixels(oiio.FLOAT), buf.spec()
+
+
+class BandsTest(unittest.TestCase):
+    def setUp(self):
+        self.tmp = tempfile.mkdtemp(prefix="mcrecon_bands_")
+
+    def tearDown(self):
+        shutil.rmtree(self.tmp, ignore_errors=True)
+
+    def out(self, name):
+        return os.path.join(self.tmp, name)
+
+    def test_bands_give_the_whole_frames_pixels(self):
+        for f in ("box", "bilateral", "guided", "pwaf"):
+            whole, banded = self.out(f + "_whole.exr"), self.out(f + "_bands.exr")
+            tu.run_cli("denoise", ROOM, "-o", whole, "-f", f)
+            proc = tu.run_cli("denoise", ROOM, "-o", banded, "-f", f, "--band-rows", "64", "-v")
+            self.assertIn("3 bands of 64 rows", proc.stderr)
+            a, sa = image(whole)
+            b, sb = image(banded)
+            self.assertEqual(sa.channelnames, sb.channelnames, f)
+            np.testing.assert_array_equal(a, b, err_msg=f)
+            for key in ("mcreconFilter", "mcreconParameters"):
+                self.assertEqual(sa.getattribute(key), sb.getattribute(key), f)
+            self.assertFalse([n for n in os.listdir(self.tmp) if n.startswith(".")], "no temp file left")
+
+    def test_max_memory_chooses_bands_and_says_when_too_little(self):
+        done = tu.run_cli("denoise", ROOM, "-o", self.out("m.exr"), "-f", "atrous", "--max-memory", "400", "-v")
+        self.assertRegex(done.stderr, r"\d+ bands of \d+ rows")
+        tiny = tu.run_cli("denoise", ROOM, "-o", self.out("t.exr"), "-f", "atrous", "--max-memory", "100", check=False)
+        self.assertEqual(tiny.returncode, 2)
+        self.assertIn("--max-memory 100 MB is too little", tiny.stderr)
+        self.assertFalse(os.path.exists(self.out("t.exr")))
+
+    def test_what_bands_cannot_do_is_refused(self):
+        cases = [
+            (["-f", "bmfr"], "--band-rows: a temporal run"),
+            (["-f", "box", "--region", "0,0,10,10"], "--band-rows: --region"),
+            (["-f", "box", "--keep-passes"], "--band-rows: --keep-passes"),
+            (["-f", "gaussian", "--set", "foveated=true"], "foveated=true"),
+        ]
+        for extra, message in cases:
+            proc = tu.run_cli("denoise", ROOM, "-o", self.out("r.exr"), "--band-rows", "64", *extra, check=False)
+            self.assertEqual(proc.returncode, 2, extra)
+            self.assertIn(message, proc.stderr, extra)
+            self.assertFalse(os.path.exists(self.out("r.exr")), extra)
+        seq = tu.run_cli("denoise", ANIM, "--frames", "1-2", "-o", self.out("s_####.exr"), "-f", "box",
+                         "--max-memory", "500", check=False)
+        self.assertEqual(seq.returncode, 2)
+        self.assertIn("--max-memory applies to one frame", seq.stderr)
+
+
+if __name__ == "__main__":
+    unittest.main()
