@@ -50,26 +50,31 @@ double band_bytes_per_pixel(const Filter& filter, int input_channels) {
 
 int band_rows_for(const Filter& filter, int width, int height, int input_channels, double max_bytes) {
   const double px = double(width) * double(height);
-  // Held for the whole frame: the result (RGB float) and the alpha; then either the
-  // statistics pass's values (pwaf: its spacing pairs and relative variance, three doubles a
-  // pixel; guided: two noise values) or, at the end, the writer's interleaved copy and its
-  // buffer (RGBA float, twice).
+  // Held for the whole frame: the result (RGB float) and the alpha; first the statistics
+  // pass's values (pwaf: its spacing pairs and relative variance, three floats a pixel;
+  // guided: two noise values), at the end the writer's interleaved RGBA copy.
   const std::string& f = filter.info().name;
-  const double stats = f == "pwaf" ? 24.0 : f == "guided" ? 16.0 : 0.0;
-  // The band and the statistics are held together; the writer comes after both are freed.
+  const double stats = f == "pwaf" ? 12.0 : f == "guided" ? 8.0 : 0.0;
+  // The statistics are freed before the filtering pass; while they are gathered a band holds
+  // what the filter computes before them (at most kMeasureShare of its planes).
+  constexpr double kMeasureShare = 0.75;
   constexpr double kProcess = 160.0 * 1024 * 1024;  // the process itself (code, libraries, thread stacks)
-  const double whole = kProcess + px * (12.0 + 4.0 + stats);
+  const double whole = kProcess + px * (12.0 + 4.0);
   const double per_row = double(width) * band_bytes_per_pixel(filter, input_channels);
   const double halo_rows = 2.0 * (filter.band_halo() + std::max(kBandAlign, filter.band_alignment()));
   // A file source keeps the rows consecutive bands share (io/band_reader.h).
   const double overlap = halo_rows * double(width) * 4.0 * input_channels;
-  const double rows = (max_bytes - whole - overlap) / per_row - halo_rows;
-  if (!(rows >= kBandAlign) || kProcess + px * (12.0 + 4.0 + 32.0) > max_bytes)
+  const double budget = max_bytes - whole - overlap;
+  const double rows = std::min(budget / per_row, (budget - px * stats) / (kMeasureShare * per_row)) - halo_rows;
+  if (!(rows >= kBandAlign) || kProcess + px * (12.0 + 4.0 + 32.0) > max_bytes) {
+    const double need = whole + overlap + std::max(per_row, kMeasureShare * per_row + px * stats / (halo_rows + kBandAlign)) *
+                                              (halo_rows + kBandAlign);
     throw Error(Errc::InvalidArgument,
                 "--max-memory " + std::to_string(int(max_bytes / (1024.0 * 1024.0))) + " MB is too little for a " +
                     std::to_string(width) + "x" + std::to_string(height) + " frame with filter '" + filter.info().name +
-                    "': at least " + std::to_string(int((whole + overlap + per_row * (halo_rows + kBandAlign)) / (1024.0 * 1024.0)) + 1) +
+                    "': at least " + std::to_string(int(std::max(need, kProcess + px * 48.0) / (1024.0 * 1024.0)) + 1) +
                     " MB");
+  }
   return int(std::min(rows, double(std::max(height, kBandAlign)))) / kBandAlign * kBandAlign;
 }
 

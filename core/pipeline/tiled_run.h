@@ -62,8 +62,9 @@ BandPlan plan_bands(int height, int band_rows, int halo);
 // --max-memory.
 double band_bytes_per_pixel(const Filter& filter, int input_channels);
 
-// Output rows per band that keep the whole run under max_bytes: the output (RGB float) and
-// the statistics pass are held for the whole frame; the rest is one band with its halo.
+// Output rows per band that keep the whole run under max_bytes: the output (RGB float and
+// alpha) is held for the whole frame, the statistics pass's values while it runs; the rest is
+// one band with its halo.
 // Throws InvalidArgument naming --max-memory when not even one aligned band fits.
 int band_rows_for(const Filter& filter, int width, int height, int input_channels, double max_bytes);
 

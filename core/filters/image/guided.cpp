@@ -51,13 +51,13 @@ double guided::auto_epsilon(double scale, double median_relative_noise) {
 }
 
 guided::FrameNoise guided::frame_noise(const Image& colour, int nthreads) {
-  std::vector<double> rel, abs;
+  std::vector<float> rel, abs;
   gather_frame_noise(colour, Roi::all(colour.width(), colour.height()), nthreads, rel, abs);
   return frame_noise_of(rel, abs);
 }
 
-void guided::gather_frame_noise(const Image& colour, const Roi& rows, int nthreads, std::vector<double>& rel,
-                                std::vector<double>& abs) {
+void guided::gather_frame_noise(const Image& colour, const Roi& rows, int nthreads, std::vector<float>& rel,
+                                std::vector<float>& abs) {
   const NoiseScales ns = estimate_noise_scales(colour, rows, nthreads);
   rel.reserve(rel.size() + ns.relative.size());
   abs.reserve(abs.size() + ns.relative.size());
@@ -66,16 +66,16 @@ void guided::gather_frame_noise(const Image& colour, const Roi& rows, int nthrea
   for (std::size_t i = 0; i < ns.relative.size(); ++i) {
     if (!ns.finite[i] || !(ns.relative[i] > 0)) continue;
     if (std::isfinite(ns.relative[i])) rel.push_back(ns.relative[i]);
-    if (std::isfinite(ns.robust(i))) abs.push_back(ns.robust(i));
+    if (std::isfinite(ns.robust(i))) abs.push_back(float(std::min(ns.robust(i), double(FLT_MAX))));
   }
 }
 
-guided::FrameNoise guided::frame_noise_of(std::vector<double>& rel, std::vector<double>& abs) {
-  auto median = [](std::vector<double>& v) {
+guided::FrameNoise guided::frame_noise_of(std::vector<float>& rel, std::vector<float>& abs) {
+  auto median = [](std::vector<float>& v) {
     if (v.empty()) return 0.0;
     auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
     std::nth_element(v.begin(), mid, v.end());
-    return *mid;
+    return double(*mid);
   };
   FrameNoise fn;
   fn.relative = median(rel);
@@ -400,14 +400,14 @@ void GuidedFilter::measure_band(const Frame& band, const Image& colour, const Ro
 bool GuidedFilter::statistics_pass_done() {
   if (statistics_pass() > 0) return false;
   if (noise_from_image()) fixed_noise_ = frame_noise_of(measured_rel_, measured_abs_);
-  std::vector<double>().swap(measured_rel_);
-  std::vector<double>().swap(measured_abs_);
+  std::vector<float>().swap(measured_rel_);
+  std::vector<float>().swap(measured_abs_);
   return true;
 }
 
 void GuidedFilter::drop_own_statistics() {
-  std::vector<double>().swap(measured_rel_);
-  std::vector<double>().swap(measured_abs_);
+  std::vector<float>().swap(measured_rel_);
+  std::vector<float>().swap(measured_abs_);
   std::vector<RowStats>().swap(row_stats_);
   fixed_noise_ = {};
 }

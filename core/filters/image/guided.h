@@ -70,9 +70,10 @@ struct FrameNoise {
 FrameNoise frame_noise(const Image& colour, int nthreads);
 // The values frame_noise() takes the medians of, for `rows` (appended), and their medians
 // (reordering them): a tiled run gathers them band by band.
-void gather_frame_noise(const Image& colour, const Roi& rows, int nthreads, std::vector<double>& relative,
-                        std::vector<double>& robust);
-FrameNoise frame_noise_of(std::vector<double>& relative, std::vector<double>& robust);
+// Kept as floats (a frame's worth is what a tiled run holds between passes).
+void gather_frame_noise(const Image& colour, const Roi& rows, int nthreads, std::vector<float>& relative,
+                        std::vector<float>& robust);
+FrameNoise frame_noise_of(std::vector<float>& relative, std::vector<float>& robust);
 
 // One row's share of the guide statistics (validity count, mean and squared deviations per
 // guide channel, exponent histogram of the colour), combined over the rows in order.
@@ -130,7 +131,7 @@ class GuidedFilter : public Filter {
   GuidedStats stats_;
   std::vector<std::vector<double>> work_;  // per row band, kept between calls
   // Tiled runs: the frame's noise (epsilon=0; a first pass) and every row's guide statistics.
-  std::vector<double> measured_rel_, measured_abs_;
+  std::vector<float> measured_rel_, measured_abs_;
   guided::FrameNoise fixed_noise_;
   std::vector<guided::RowStats> row_stats_;
   bool measuring_rows_ = false;

@@ -45,7 +45,7 @@ bool feature_at(const Image& im, int x, int y, float v[3]) {
 
 // The non-zero distances between horizontally and vertically adjacent finite pixels whose
 // first pixel lies in `rows` (the pair below a row's pixel is taken where the image has it).
-void adjacent_distances(const Image& im, const Roi& rows, std::vector<double>& d) {
+void adjacent_distances(const Image& im, const Roi& rows, std::vector<float>& d) {
   const int w = im.width(), h = im.height();
   auto dist = [&](int x0, int y0, int x1, int y1) {
     float a[3], b[3];
@@ -64,8 +64,10 @@ void adjacent_distances(const Image& im, const Roi& rows, std::vector<double>& d
     }
 }
 
-// The median of the values (0 when there are none); reorders them.
-double median_of(std::vector<double>& v) {
+// The median of the values (0 when there are none); reorders them. Kept as floats: a frame's
+// worth of them is what a tiled run holds between its passes (the median of the rounded
+// values is the rounded median: rounding keeps the order).
+double median_of(std::vector<float>& v) {
   if (v.empty()) return 0.0;
   std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
   return v[v.size() / 2];
@@ -86,7 +88,7 @@ Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing, doub
     if (spacing >= 0) {
       if (spacing > 0) scale = spacing;
     } else {
-      std::vector<double> d;
+      std::vector<float> d;
       d.reserve(std::size_t(im.width()) * std::size_t(im.height()) * 2);
       adjacent_distances(im, Roi::all(im.width(), im.height()), d);
       if (!d.empty()) scale = median_of(d);
@@ -198,8 +200,8 @@ void PwafFilter::fix_statistics() {
 }
 
 void PwafFilter::drop_measured() {
-  std::vector<double>().swap(measured_spacing_);
-  std::vector<double>().swap(measured_rho_);
+  std::vector<float>().swap(measured_spacing_);
+  std::vector<float>().swap(measured_rho_);
 }
 
 void PwafFilter::drop_own_statistics() {
@@ -371,16 +373,16 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       for (int y = roi.y0; y < roi.y1; ++y)
         for (int x = roi.x0; x < roi.x1; ++x) {
           const std::size_t i = std::size_t(y) * w + x;
-          if (valid[i] && std::isfinite(rho[i])) measured_rho_.push_back(rho[i]);
+          if (valid[i] && std::isfinite(rho[i])) measured_rho_.push_back(float(rho[i]));
         }
       return;
     }
     double median = fixed_rho_median_;
     if (!statistics_fixed()) {
-      std::vector<double> sorted;
+      std::vector<float> sorted;
       sorted.reserve(rho.size());
       for (std::size_t i = 0; i < rho.size(); ++i)
-        if (valid[i] && std::isfinite(rho[i])) sorted.push_back(rho[i]);
+        if (valid[i] && std::isfinite(rho[i])) sorted.push_back(float(rho[i]));
       median = median_of(sorted);
     }
     stats_.median_rel_variance = median;

@@ -67,7 +67,7 @@ class PwafFilter : public Filter {
   // Tiled runs: the frame's median adjacent position distance and median relative variance
   // (measured band by band, then fixed).
   bool measuring_ = false;
-  std::vector<double> measured_spacing_, measured_rho_;
+  std::vector<float> measured_spacing_, measured_rho_;
   double fixed_spacing_ = 0, fixed_rho_median_ = 0;
 };
 
