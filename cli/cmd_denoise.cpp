@@ -155,7 +155,7 @@ int run_denoise(const DenoiseArgs& a) {
     const StageTimes t = session.run_in_bands(a.input, a.output, ro, wo, eo, a.band_rows,
                                               double(a.max_memory) * 1024.0 * 1024.0, [&](int d, int all) {
                                                 if (!bar) bar = std::make_unique<Progress>("denoise " + a.filter + " in bands", all);
-                                                bar->step(d, d * 2 <= all ? "statistics" : "filter");
+                                                bar->step(d, "statistics passes, then the filter");
                                               });
     if (bar) bar->finish(a.output);
     if (a.verbose)

@@ -178,6 +178,18 @@ void Filter::measure(const Frame& band, const Roi& rows, int nthreads) {
   prepared_ = Prepared{};
 }
 
+void Filter::run_to_measure(const Frame& band, const Image& colour, const Roi& rows, int nthreads) {
+  measuring_run_ = true;
+  try {
+    Image none;
+    run(band, colour, rows, none, nthreads);
+  } catch (...) {
+    measuring_run_ = false;
+    throw;
+  }
+  measuring_run_ = false;
+}
+
 bool Filter::end_statistics_pass() {
   if (stats_state_ != StatsState::Measuring) throw Error(Errc::Internal, "filter '" + info_.name + "': end_statistics_pass() without begin");
   if (stats_pass_ == 0) {

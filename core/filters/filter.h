@@ -143,6 +143,10 @@ class Filter {
   virtual void measure_band(const Frame& band, const Image& colour, const Roi& rows, int nthreads) {
     (void)band, (void)colour, (void)rows, (void)nthreads;
   }
+  // For a filter whose statistics come out of its own first stages: run() on the band's rows
+  // with measuring_run() true (it records them and returns before filtering).
+  void run_to_measure(const Frame& band, const Image& colour, const Roi& rows, int nthreads);
+  bool measuring_run() const { return measuring_run_; }
   virtual void fix_statistics() {}
   // The pass just measured is complete: true to measure every band again (statistics_pass()
   // then counts it), false when the filter's statistics are fixed.
@@ -174,6 +178,7 @@ class Filter {
   std::vector<std::pair<std::string, std::shared_ptr<const WholeFrameRange>>> ranges_;
   std::size_t measured_holes_ = 0;
   int stats_pass_ = 0;
+  bool measuring_run_ = false;
 };
 
 }  // namespace mcr

@@ -106,6 +106,14 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
     rows = Roi{0, y0 - r0, w, y1 - r0};
     return std::make_pair(r0, r1);
   };
+  // Band b's frame with the statistics fixed so far; rows: its own, in its coordinates.
+  auto fetch = [&](int b, Roi& rows, int& r0) {
+    const auto [top, bottom] = band_of(b, rows);
+    r0 = top;
+    Frame band = source.rows(top, bottom);
+    filter.attach_statistics(band);
+    return band;
+  };
 
   int step = 0, passes = 1;
   auto stepped = [&] {
@@ -117,9 +125,8 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
     do {
       for (int b = 0; b < plan.bands; ++b) {
         Roi rows;
-        const auto [r0, r1] = band_of(b, rows);
-        Frame band = source.rows(r0, r1);
-        filter.attach_statistics(band);
+        int r0 = 0;
+        const Frame band = fetch(b, rows, r0);
         filter.measure(band, rows, options.nthreads);
         stepped();
       }
@@ -135,9 +142,8 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
   try {
     for (int b = 0; b < plan.bands; ++b) {
       Roi rows;
-      const auto [r0, r1] = band_of(b, rows);
-      Frame band = source.rows(r0, r1);
-      filter.attach_statistics(band);
+      int r0 = 0;
+      const Frame band = fetch(b, rows, r0);
       ExecOptions eo;
       eo.nthreads = options.nthreads;
       eo.roi = rows.grown(margin, band.width, band.height);

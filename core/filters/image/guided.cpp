@@ -327,7 +327,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   c.eps = params_.get_float("epsilon");
   double colour_scale = 0;  // epsilon=0: a colour guide is divided by at least its level
   if (c.eps == 0.0) {
-    const FrameNoise fn = statistics_fixed() || measuring_rows_ ? fixed_noise_ : frame_noise(*colour, nthreads);
+    const FrameNoise fn = statistics_fixed() || measuring_run() ? fixed_noise_ : frame_noise(*colour, nthreads);
     c.eps = auto_epsilon(params_.get_float("epsilon_scale"), fn.relative);
     colour_scale = fn.level;
     note("epsilon " + number_text(c.eps) + " from the noise (median relative noise variance " + number_text(fn.relative) +
@@ -367,7 +367,7 @@ void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& ro
   }
 
   stats_ = GuidedStats{};
-  std::vector<RowStats>* rows_in = measuring_rows_ ? &row_stats_ : nullptr;
+  std::vector<RowStats>* rows_in = measuring_run() ? &row_stats_ : nullptr;
   const std::vector<RowStats>* rows_fixed = statistics_fixed() ? &row_stats_ : nullptr;
   switch (d) {
     case 1: filter_d<1>(c, groups, unit, min_scale, roi, out, nthreads, stats_, work_, rows_in, rows_fixed); break;
@@ -386,15 +386,7 @@ void GuidedFilter::measure_band(const Frame& band, const Image& colour, const Ro
     if (noise_from_image()) gather_frame_noise(colour, rows, nthreads, measured_rel_, measured_abs_);
     return;
   }
-  measuring_rows_ = true;
-  try {
-    Image none;
-    run(band, colour, rows, none, nthreads);
-  } catch (...) {
-    measuring_rows_ = false;
-    throw;
-  }
-  measuring_rows_ = false;
+  run_to_measure(band, colour, rows, nthreads);
 }
 
 bool GuidedFilter::statistics_pass_done() {

@@ -134,7 +134,6 @@ class GuidedFilter : public Filter {
   std::vector<float> measured_rel_, measured_abs_;
   guided::FrameNoise fixed_noise_;
   std::vector<guided::RowStats> row_stats_;
-  bool measuring_rows_ = false;
 };
 
 }  // namespace mcr

@@ -182,15 +182,7 @@ void PwafFilter::measure_band(const Frame& band, const Image& colour, const Roi&
   if (!pos) pos = band.find(Role::Position, Prefer::Geometry);
   if (pos) adjacent_distances(pos->image, rows, measured_spacing_);
   if (!params_.get_bool("adaptive")) return;
-  measuring_ = true;
-  try {
-    Image none;
-    run(band, colour, rows, none, nthreads);
-  } catch (...) {
-    measuring_ = false;
-    throw;
-  }
-  measuring_ = false;
+  run_to_measure(band, colour, rows, nthreads);
 }
 
 void PwafFilter::fix_statistics() {
@@ -369,7 +361,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
         rho[i] = pwaf::relative_variance(variance[i], luminance(est.pixel(x, y)));
       }
     });
-    if (measuring_) {  // a tiled run's statistics pass: this band's rows, nothing filtered
+    if (measuring_run()) {  // a tiled run's statistics pass: this band's rows, nothing filtered
       for (int y = roi.y0; y < roi.y1; ++y)
         for (int x = roi.x0; x < roi.x1; ++x) {
           const std::size_t i = std::size_t(y) * w + x;

@@ -66,7 +66,6 @@ class PwafFilter : public Filter {
   PwafStats stats_;
   // Tiled runs: the frame's median adjacent position distance and median relative variance
   // (measured band by band, then fixed).
-  bool measuring_ = false;
   std::vector<float> measured_spacing_, measured_rho_;
   double fixed_spacing_ = 0, fixed_rho_median_ = 0;
 };
