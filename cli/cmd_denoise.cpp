@@ -144,24 +144,37 @@ int run_denoise(const DenoiseArgs& a) {
     }
   }
   if (a.max_memory > 0 || a.band_rows > 0) {
+    // Each frame in bands, one after the other (a temporal run is refused before any work).
     const std::string opt = a.band_rows > 0 ? "--band-rows" : "--max-memory";
-    if (seq) throw Error(Errc::InvalidArgument, opt + " applies to one frame; run a sequence's frames one call each");
     if (!a.half.empty()) throw Error(Errc::InvalidArgument, opt + ": --half merges two whole frames; not in bands");
-    if (done[0]) {
-      std::cerr << "mcrecon: " << a.output << " is done (same filter, parameters and input): kept (--resume)\n";
-      return 0;
+    if (temporal)
+      throw Error(Errc::InvalidArgument, opt + ": a temporal run (history between frames) is not cut into bands");
+    const std::vector<int>& list = frames.frames();
+    if (seq && std::count(done.begin(), done.end(), true))
+      std::cerr << "mcrecon: " << std::count(done.begin(), done.end(), true) << " of " << frames.size()
+                << " frames already done (--resume)\n";
+    Progress frames_bar("denoise " + a.filter + " in bands", int(list.size()));
+    for (std::size_t i = 0; i < list.size(); ++i) {
+      if (done[i]) {
+        if (!seq) std::cerr << "mcrecon: " << a.output << " is done (same filter, parameters and input): kept (--resume)\n";
+        continue;
+      }
+      std::unique_ptr<Progress> bar;  // a single frame: progress per band
+      const StageTimes t = session.run_in_bands(input_of(list[i]), output_of(list[i]), ro, wo, eo, a.band_rows,
+                                                double(a.max_memory) * 1024.0 * 1024.0, [&](int d, int all) {
+                                                  if (seq) return;
+                                                  if (!bar) bar = std::make_unique<Progress>("denoise " + a.filter + " in bands", all);
+                                                  bar->step(d, "statistics passes, then the filter");
+                                                });
+      if (bar) bar->finish(a.output);
+      if (a.verbose)
+        for (const auto& n : t.notes)
+          if (std::find(unused.begin(), unused.end(), n) == unused.end())
+            std::cerr << "mcrecon: " << input_of(list[i]) << ": " << n << "\n";
+      if (seq) frames_bar.step(int(i + 1), output_of(list[i]) + (a.timings || a.verbose ? "  " + times_text(t) : ""));
+      else if (a.timings || a.verbose) std::cerr << "mcrecon: " << a.output << ": " << times_text(t) << "\n";
     }
-    std::unique_ptr<Progress> bar;
-    const StageTimes t = session.run_in_bands(a.input, a.output, ro, wo, eo, a.band_rows,
-                                              double(a.max_memory) * 1024.0 * 1024.0, [&](int d, int all) {
-                                                if (!bar) bar = std::make_unique<Progress>("denoise " + a.filter + " in bands", all);
-                                                bar->step(d, "statistics passes, then the filter");
-                                              });
-    if (bar) bar->finish(a.output);
-    if (a.verbose)
-      for (const auto& n : t.notes)
-        if (std::find(unused.begin(), unused.end(), n) == unused.end()) std::cerr << "mcrecon: " << a.input << ": " << n << "\n";
-    if (a.timings || a.verbose) std::cerr << "mcrecon: " << a.output << ": " << times_text(t) << "\n";
+    if (seq) frames_bar.finish();
     return 0;
   }
   const std::vector<FrameJob> jobs = plan_sequence(frames, done, temporal, a.warmup);

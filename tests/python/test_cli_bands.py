@@ -65,10 +65,20 @@ class BandsTest(unittest.TestCase):
             self.assertEqual(proc.returncode, 2, extra)
             self.assertIn(message, proc.stderr, extra)
             self.assertFalse(os.path.exists(self.out("r.exr")), extra)
-        seq = tu.run_cli("denoise", ANIM, "--frames", "1-2", "-o", self.out("s_####.exr"), "-f", "box",
-                         "--max-memory", "500", check=False)
-        self.assertEqual(seq.returncode, 2)
-        self.assertIn("--max-memory applies to one frame", seq.stderr)
+        temporal = tu.run_cli("denoise", ANIM, "--frames", "1-2", "-o", self.out("s_####.exr"), "-f", "box",
+                              "--accumulate", "--max-memory", "500", check=False)
+        self.assertEqual(temporal.returncode, 2)
+        self.assertIn("--max-memory: a temporal run", temporal.stderr)
+        self.assertFalse(os.path.exists(self.out("s_0001.exr")))
+
+    def test_a_sequence_runs_frame_by_frame_in_bands(self):
+        tu.run_cli("denoise", ANIM, "--frames", "1-3", "-o", self.out("w_####.exr"), "-f", "pwaf")
+        tu.run_cli("denoise", ANIM, "--frames", "1-3", "-o", self.out("b_####.exr"), "-f", "pwaf", "--band-rows", "64")
+        for f in (1, 2, 3):
+            np.testing.assert_array_equal(image(self.out("w_%04d.exr" % f))[0], image(self.out("b_%04d.exr" % f))[0])
+        again = tu.run_cli("denoise", ANIM, "--frames", "1-3", "-o", self.out("b_####.exr"), "-f", "pwaf",
+                           "--band-rows", "64", "--resume")
+        self.assertIn("3 of 3 frames already done", again.stderr)
 
 
 if __name__ == "__main__":
