@@ -3,6 +3,7 @@
 #include <OpenImageIO/imageio.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cstring>
 
 #include "io/input_limits.h"
@@ -51,6 +52,7 @@ struct FileBands::Impl {
   // it instead of decoded again.
   Frame last;  // its last rows only: [last_y0, last_y1)
   int last_y0 = 0, last_y1 = 0, keep = 0;
+  double read_ms = 0;
 };
 
 FileBands::FileBands(const std::string& path, const ReadOptions& options, const std::vector<Role>& roles)
@@ -101,8 +103,11 @@ int FileBands::kept_channels() const {
 }
 const Frame& FileBands::layout() const { return impl_->layout; }
 
+double FileBands::read_ms() const { return impl_->read_ms; }
+
 Frame FileBands::rows(int y0, int y1) {
   Impl& m = *impl_;
+  const auto t0 = std::chrono::steady_clock::now();
   const int w = m.spec.width, nch = m.spec.nchannels;
   if (y0 < 0 || y1 > m.spec.height || y0 >= y1)
     throw Error(Errc::Internal, "band reader: rows " + std::to_string(y0) + ".." + std::to_string(y1) + " outside '" + m.path + "'");
@@ -148,6 +153,7 @@ Frame FileBands::rows(int y0, int y1) {
     if (tail.height() > 0) std::memcpy(tail.data(), p.image.pixel(0, m.last_y0 - y0), row * std::size_t(tail.height()) * sizeof(float));
     m.last.passes.push_back(with_pixels(p, std::move(tail)));
   }
+  m.read_ms += std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return f;
 }
 

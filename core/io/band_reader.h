@@ -27,6 +27,8 @@ class FileBands : public BandSource {
   // Channels decoded per pixel (the file's) and kept per pixel (the passes kept).
   int file_channels() const;
   int kept_channels() const;
+  // Milliseconds spent in rows() so far (decoding and copying).
+  double read_ms() const;
   // The frame's header and passes with one row of pixels (names, roles, window, layers).
   const Frame& layout() const;
 

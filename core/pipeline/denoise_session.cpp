@@ -151,7 +151,8 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   if (filter.measured_holes())
     notes.push_back(std::to_string(filter.measured_holes()) +
                     " unsampled pixels filled by each band's own pull-push (not the whole frame's: those pixels may differ)");
-  t.filter_ms = ms_since(t0);  // reading is interleaved with filtering: counted here
+  t.read_ms = source.read_ms();  // the bands' reads, interleaved with filtering
+  t.filter_ms = ms_since(t0) - t.read_ms;
   t.notes = std::move(notes);
   f.attributes = {{"mcreconFilter", filter.info().name},
                   {"mcreconParameters", reconstruction_.parameters_text()},
