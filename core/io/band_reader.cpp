@@ -17,7 +17,8 @@ namespace mcr {
 
 namespace {
 
-constexpr int kChunkRows = 32;  // rows decoded at a time (two zip blocks of 16)
+constexpr int kChunkRows = 32;     // rows decoded at a time (two zip blocks of 16)
+constexpr int kMaxTileRows = 1024;  // a tiled file is decoded a row of tiles at a time
 
 std::unique_ptr<ImageInput> open_for_bands(const std::string& path, std::string& why) {
   check_image_file(path);  // FileNotFound, NotAnImage, a header its bytes cannot back
@@ -27,6 +28,9 @@ std::unique_ptr<ImageInput> open_for_bands(const std::string& path, std::string&
   if (spec.deep) why = "it is a deep file";
   else if (in->seek_subimage(1, 0)) why = "it has several parts";
   else if (spec.depth > 1) why = "it is a volume";
+  else if (spec.tile_width > 0 && spec.tile_height > kMaxTileRows)
+    why = "its tiles are " + std::to_string(spec.tile_height) + " rows tall (bands read whole rows of tiles, at most " +
+          std::to_string(kMaxTileRows) + ")";
   in->seek_subimage(0, 0);
   return in;
 }
@@ -125,23 +129,33 @@ Frame FileBands::rows(int y0, int y1) {
     }
     from = c1;
   }
-  std::vector<float> chunk(std::size_t(w) * std::size_t(nch) * kChunkRows);
-  for (int c0 = from; c0 < y1; c0 += kChunkRows) {
-    const int c1 = std::min(y1, c0 + kChunkRows);
-    if (!m.in->read_scanlines(0, 0, m.spec.y + c0, m.spec.y + c1, 0, 0, nch, TypeDesc::FLOAT, chunk.data()))
-      throw Error(Errc::ReadFailed, "cannot read rows " + std::to_string(c0) + ".." + std::to_string(c1) + " of '" + m.path +
+  // Scanline files in chunks of kChunkRows; tiled ones a row of tiles at a time (OpenImageIO
+  // reads tiles only on their grid), of which the rows wanted are copied.
+  const int tile_h = m.spec.tile_width > 0 ? std::max(1, m.spec.tile_height) : 0;
+  const int chunk_rows = tile_h > 0 ? tile_h : kChunkRows;
+  std::vector<float> chunk(std::size_t(w) * std::size_t(nch) * std::size_t(chunk_rows));
+  for (int c0 = from; c0 < y1;) {
+    const int t0 = tile_h > 0 ? c0 / tile_h * tile_h : c0;  // the chunk's first row in the file
+    const int t1 = std::min(m.spec.height, t0 + chunk_rows);
+    const int c1 = std::min(y1, t1);
+    const bool ok = tile_h > 0 ? m.in->read_tiles(0, 0, m.spec.x, m.spec.x + w, m.spec.y + t0, m.spec.y + t1, m.spec.z,
+                                                   m.spec.z + 1, 0, nch, TypeDesc::FLOAT, chunk.data())
+                               : m.in->read_scanlines(0, 0, m.spec.y + t0, m.spec.y + t1, 0, 0, nch, TypeDesc::FLOAT, chunk.data());
+    if (!ok)
+      throw Error(Errc::ReadFailed, "cannot read rows " + std::to_string(t0) + ".." + std::to_string(t1) + " of '" + m.path +
                                         "': " + m.in->geterror());
     for (std::size_t k = 0; k < f.passes.size(); ++k) {
       Image& im = f.passes[k].image;
       const std::vector<int>& src = m.sources[k];
       const int pc = im.channels();
       parallel_rows(c0, c1, 0, [&](int y) {
-        const float* s = chunk.data() + std::size_t(y - c0) * std::size_t(w) * std::size_t(nch);
+        const float* s = chunk.data() + std::size_t(y - t0) * std::size_t(w) * std::size_t(nch);
         float* d = im.pixel(0, y - y0);
         for (int x = 0; x < w; ++x)
           for (int c = 0; c < pc; ++c) d[std::size_t(x) * pc + c] = s[std::size_t(x) * nch + src[std::size_t(c)]];
       });
     }
+    c0 = c1;
   }
   // The rows the next band may share, copied: the caller's band may be changed.
   m.last_y1 = y1;

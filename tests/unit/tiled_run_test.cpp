@@ -2,6 +2,8 @@
 // bit for bit; the oracle is the filter's own whole-frame execute().
 #include <gtest/gtest.h>
 
+#include <OpenImageIO/imagebuf.h>
+
 #include <algorithm>
 #include <cstring>
 #include <random>
@@ -12,6 +14,7 @@
 #include "kernels/feature_activity.h"
 #include "pipeline/reconstruction.h"
 #include "pipeline/tiled_run.h"
+#include "scratch_dir.h"
 
 namespace mcr {
 namespace {
@@ -145,6 +148,30 @@ TEST(TiledRun, OverlappingBandsOfAFileHoldItsRows) {
   FileBands bands(path, {}, {Role::Normal});
   bands.overlap_hint(50);
   for (const auto& [y0, y1] : {std::pair<int, int>{0, 80}, {40, 130}, {100, 192}, {0, 64}}) {
+    const Frame part = bands.rows(y0, y1);
+    for (Role r : {Role::Colour, Role::Normal}) {
+      const Image& a = part.image(r);
+      EXPECT_EQ(std::memcmp(a.data(), frame.image(r).pixel(0, y0), sizeof(float) * std::size_t(a.width()) * std::size_t(y1 - y0) * std::size_t(a.channels())), 0)
+          << role_name(r) << " rows " << y0 << ".." << y1;
+    }
+  }
+}
+
+// A tiled EXR (OpenImageIO reads tiles only on their grid): bands that start and end inside
+// rows of tiles hold the file's rows.
+TEST(TiledRun, ATiledFilesBandsHoldItsRows) {
+  testutil::ScratchDir dir("mcrecon_tiled_bands");
+  const std::string path = dir.path("tiled.exr");
+  {
+    OIIO::ImageBuf src(sample("glossy"));
+    ASSERT_TRUE(src.read(0, 0, true, OIIO::TypeDesc::FLOAT));
+    src.set_write_tiles(16, 16);
+    ASSERT_TRUE(src.write(path));
+  }
+  const Frame frame = read_frame(path);
+  FileBands bands(path, {}, {Role::Normal});
+  bands.overlap_hint(40);
+  for (const auto& [y0, y1] : {std::pair<int, int>{5, 77}, {50, 192}}) {
     const Frame part = bands.rows(y0, y1);
     for (Role r : {Role::Colour, Role::Normal}) {
       const Image& a = part.image(r);
