@@ -57,11 +57,11 @@ int band_rows_for(const Filter& filter, int width, int height, int input_channel
   const double stats = f == "pwaf" ? 12.0 : f == "guided" ? 8.0 : 0.0;
   // The statistics are freed before the filtering pass; while they are gathered a band holds
   // what the filter computes before them (at most kMeasureShare of its planes).
-  constexpr double kMeasureShare = 0.75;
+  constexpr double kMeasureShare = 0.6;
   constexpr double kProcess = 160.0 * 1024 * 1024;  // the process itself (code, libraries, thread stacks)
   const double whole = kProcess + px * (12.0 + 4.0);
   const double per_row = double(width) * band_bytes_per_pixel(filter, input_channels);
-  const double halo_rows = 2.0 * (filter.band_halo() + std::max(kBandAlign, filter.band_alignment()));
+  const double halo_rows = 2.0 * filter.band_halo() + std::max(kBandAlign, filter.band_alignment());
   // A file source keeps the rows consecutive bands share (io/band_reader.h).
   const double overlap = halo_rows * double(width) * 4.0 * input_channels;
   const double budget = max_bytes - whole - overlap;
