@@ -166,13 +166,14 @@ void Filter::measure(const Frame& band, const Roi& rows, int nthreads) {
   const Roi r = rows.clipped(band.width, band.height);
   if (r.empty()) return;
   prepare(band, params_, info_.steps, reads(r, band.width, band.height), nthreads, prepared_);
-  if (stats_pass_ == 0) measured_holes_ += prepared_.holes;
-  for (const Pass& p : prepared_.frame->passes) {
-    if (stats_pass_ > 0) break;
-    if (p.image.channels() < 1) continue;
-    auto it = std::find_if(measuring_ranges_.begin(), measuring_ranges_.end(), [&](const auto& e) { return e.first == p.name; });
-    if (it == measuring_ranges_.end()) it = measuring_ranges_.insert(measuring_ranges_.end(), {p.name, WholeFrameRange{}});
-    extend_frame_range(p.image, std::min(p.image.channels(), 3), r, it->second);
+  if (stats_pass_ == 0) {  // the first pass: the holes and every pass's spread
+    measured_holes_ += prepared_.holes;
+    for (const Pass& p : prepared_.frame->passes) {
+      if (p.image.channels() < 1) continue;
+      auto it = std::find_if(measuring_ranges_.begin(), measuring_ranges_.end(), [&](const auto& e) { return e.first == p.name; });
+      if (it == measuring_ranges_.end()) it = measuring_ranges_.insert(measuring_ranges_.end(), {p.name, WholeFrameRange{}});
+      extend_frame_range(p.image, std::min(p.image.channels(), 3), r, it->second);
+    }
   }
   measure_band(*prepared_.frame, prepared_.colour, r, nthreads);
   prepared_ = Prepared{};

@@ -95,6 +95,12 @@ class Filter {
   int band_margin() const;
   // Rows a band's first row must be a multiple of (grids its estimates lie on): a multiple of 64.
   virtual int band_alignment() const { return 64; }
+  // For the band height --max-memory gives (pipeline/tiled_run.h): bytes per pixel of a band
+  // that its working planes take beyond the passes read (the preparation's copies, its own
+  // planes; peak RSS measured on a 4096x3072 frame, README "Huge frames", plus a tenth), and
+  // bytes per pixel of the frame its statistics hold while they are gathered.
+  virtual double band_work_bytes() const { return 224; }
+  virtual double statistics_bytes() const { return 0; }
   // The statistics passes: begin_statistics(); then, while end_statistics_pass() says another
   // is needed, attach_statistics() and measure() on every band in frame order (`rows`: the
   // band's own rows, in its coordinates); then attach_statistics() on each band before its

@@ -54,6 +54,17 @@ struct DenoiseSession::Filtered {
   StageTimes times;
 };
 
+void DenoiseSession::check_output(const std::string& input, const std::string& output, const ReadOptions& read,
+                                  const WriteOptions& write) {
+  if (output.empty()) return;
+  // Every front end's file run passes here: the output is checked against every input of
+  // the run (the render and any loose pass file) before anything is read.
+  std::vector<std::string> inputs = loose_pass_files(read);
+  inputs.push_back(input);
+  check_output_path(output, inputs);
+  check_write(output, write);  // Python and the add-on too: what the name says, or an error
+}
+
 Frame DenoiseSession::read_checked(const std::string& input, const std::string& output, const ReadOptions& read,
                                    const WriteOptions& write) const {
   if (write.keep_components) check_keep_components(reconstruction_.filter().params());
@@ -63,14 +74,7 @@ Frame DenoiseSession::read_checked(const std::string& input, const std::string& 
     throw Error(Errc::InvalidArgument, "--half '" + read.second_half + "' with components=light_passes: the halves' "
                                        "light passes are not merged; denoise one render with components=light_passes, "
                                        "or the halves with components=beauty");
-  if (!output.empty()) {
-    // Every front end's file run passes here: the output is checked against every
-    // input of the run (the render and any loose pass file) before anything is read.
-    std::vector<std::string> inputs = loose_pass_files(read);
-    inputs.push_back(input);
-    check_output_path(output, inputs);
-    check_write(output, write);  // Python and the add-on too: what the name says, or an error
-  }
+  check_output(input, output, read, write);
   return read_frame(input, read);
 }
 
@@ -120,10 +124,7 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   if (!(exec.roi == Roi{})) refuse("--region filters part of the frame; bands filter all of it");
   if (write.keep_passes || write.keep_components) refuse("--keep-passes and --keep-components write every pass whole");
   if (filter.band_halo() < 0) refuse("filter '" + filter.info().name + "': " + filter.why_not_tileable());
-  if (!output.empty()) {
-    check_output_path(output, {input});
-    check_write(output, write);
-  }
+  check_output(input, output, read, write);
   release_freed_memory();
   StageTimes t;
   const auto t0 = std::chrono::steady_clock::now();
@@ -144,13 +145,8 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   f.frame.window = source.layout().window;
   std::vector<std::string> notes;
   f.result = run_tiled(filter, source, o, &notes, &f.frame);
-  const BandPlan plan = plan_bands(source.height(), o.band_rows, filter.band_halo());
-  notes.insert(notes.begin(), std::to_string(plan.bands) + (plan.bands == 1 ? " band of " : " bands of ") + std::to_string(plan.band_rows) + " rows (halo " +
-                                  std::to_string(plan.halo) + "), " + std::to_string(source.kept_channels()) + " of " +
-                                  std::to_string(source.file_channels()) + " channels kept");
-  if (filter.measured_holes())
-    notes.push_back(std::to_string(filter.measured_holes()) +
-                    " unsampled pixels filled by each band's own pull-push (not the whole frame's: those pixels may differ)");
+  notes.front() += ", " + std::to_string(source.kept_channels()) + " of " + std::to_string(source.file_channels()) +
+                   " channels kept";
   t.read_ms = source.read_ms();  // the bands' reads, interleaved with filtering
   t.filter_ms = ms_since(t0) - t.read_ms;
   t.notes = std::move(notes);

@@ -63,6 +63,9 @@ class DenoiseSession {
 
  private:
   struct Filtered;
+  // The output against every input of the run (never one of them) and the write options.
+  static void check_output(const std::string& input, const std::string& output, const ReadOptions& read,
+                           const WriteOptions& write);
   Frame read_checked(const std::string& input, const std::string& output, const ReadOptions& read,
                      const WriteOptions& write) const;
   void filter_into(Filtered& f, const WriteOptions& write, const ExecOptions& exec);

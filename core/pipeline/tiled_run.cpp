@@ -38,30 +38,18 @@ BandPlan plan_bands(int height, int band_rows, int halo) {
   return p;
 }
 
-double band_bytes_per_pixel(const Filter& filter, int input_channels) {
-  // The filter's working planes per pixel of a band (the preparation's colour copies and
-  // divisor, the filter's own planes and scratch): peak RSS less what the run holds besides,
-  // over the band's pixels, on a 4096x3072 frame (README, "Huge frames"), plus a tenth.
-  const std::string& f = filter.info().name;
-  const double work = f == "box" ? 144 : f == "gaussian" ? 184 : f == "bilateral" ? 192 : f == "atrous" ? 208
-                      : f == "guided" ? 192 : f == "pwaf" ? 200 : 224;
-  return 4.0 * input_channels + work;  // the band's passes as read
-}
-
 int band_rows_for(const Filter& filter, int width, int height, int input_channels, double max_bytes) {
   const double px = double(width) * double(height);
   // Held for the whole frame: the result (RGB float) and the alpha; first the statistics
-  // pass's values (pwaf: its spacing pairs and relative variance, three floats a pixel;
-  // guided: two noise values), at the end the writer's interleaved RGBA copy.
-  const std::string& f = filter.info().name;
-  const double stats = f == "pwaf" ? 12.0 : f == "guided" ? 8.0 : 0.0;
+  // pass's values (Filter::statistics_bytes()), at the end the writer's interleaved RGBA copy.
+  const double stats = filter.statistics_bytes();
   // The statistics are freed before the filtering pass; while they are gathered a band holds
   // what the filter computes before them (at most kMeasureShare of its planes).
   constexpr double kMeasureShare = 0.6;
   constexpr double kProcess = 160.0 * 1024 * 1024;  // the process itself (code, libraries, thread stacks)
   const double whole = kProcess + px * (12.0 + 4.0);
-  const double per_row = double(width) * band_bytes_per_pixel(filter, input_channels);
-  const double halo_rows = 2.0 * filter.band_halo() + std::max(kBandAlign, filter.band_alignment());
+  const double per_row = double(width) * (4.0 * input_channels + filter.band_work_bytes());  // the passes read, the planes
+  const double halo_rows = 2.0 * filter.band_halo() + filter.band_alignment();
   // A file source keeps the rows consecutive bands share (io/band_reader.h).
   const double overlap = halo_rows * double(width) * 4.0 * input_channels;
   const double budget = max_bytes - whole - overlap;
@@ -89,28 +77,22 @@ void add_notes(const std::vector<std::string>& from, std::vector<std::string>& t
 
 Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes,
                 Frame* kept) {
-  const int halo = filter.band_halo(), margin = filter.band_margin();
+  const int halo = filter.band_halo(), margin = filter.band_margin(), align = filter.band_alignment();
   if (halo < 0)
     throw Error(Errc::InvalidArgument, "filter '" + filter.info().name + "' cannot run in bands under these settings (" +
                                            filter.why_not_tileable() + ")");
   const int w = source.width(), h = source.height();
   const BandPlan plan = plan_bands(h, options.band_rows, halo);
-  source.overlap_hint(2 * plan.halo + std::max(kBandAlign, filter.band_alignment()));
-  std::vector<std::string> said;
-  const int align = std::max(kBandAlign, filter.band_alignment());
-  auto band_of = [&](int b, Roi& rows) {
-    const int y0 = b * plan.band_rows, y1 = std::min(h, y0 + plan.band_rows);
-    // The halo rounded out to whole alignment steps: a band's frame starts on the grid too.
-    const int r0 = std::max(0, (y0 - plan.halo) / align * align);
-    const int r1 = std::min(h, y1 + plan.halo);
-    rows = Roi{0, y0 - r0, w, y1 - r0};
-    return std::make_pair(r0, r1);
-  };
-  // Band b's frame with the statistics fixed so far; rows: its own, in its coordinates.
+  source.overlap_hint(2 * plan.halo + align);
+  std::vector<std::string> said = {std::to_string(plan.bands) + (plan.bands == 1 ? " band of " : " bands of ") +
+                                   std::to_string(plan.band_rows) + " rows (halo " + std::to_string(plan.halo) + ")"};
+  // Band b's frame with the statistics fixed so far; rows: its own, in its coordinates; r0:
+  // its first row in the frame (the halo rounded out to the filter's grid).
   auto fetch = [&](int b, Roi& rows, int& r0) {
-    const auto [top, bottom] = band_of(b, rows);
-    r0 = top;
-    Frame band = source.rows(top, bottom);
+    const int y0 = b * plan.band_rows, y1 = std::min(h, y0 + plan.band_rows);
+    r0 = std::max(0, (y0 - plan.halo) / align * align);
+    rows = Roi{0, y0 - r0, w, y1 - r0};
+    Frame band = source.rows(r0, std::min(h, y1 + plan.halo));
     filter.attach_statistics(band);
     return band;
   };
@@ -120,26 +102,23 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
     ++step;
     if (options.progress) options.progress(step, (passes + 1) * plan.bands);
   };
+  Image out(w, h, 3);
   filter.begin_statistics();
   try {
     do {
       for (int b = 0; b < plan.bands; ++b) {
         Roi rows;
         int r0 = 0;
-        const Frame band = fetch(b, rows, r0);
-        filter.measure(band, rows, options.nthreads);
+        filter.measure(fetch(b, rows, r0), rows, options.nthreads);
         stepped();
       }
       ++passes;
     } while (filter.end_statistics_pass());
     --passes;
-  } catch (...) {
-    filter.drop_statistics();
-    throw;
-  }
+    if (filter.measured_holes())
+      said.push_back(std::to_string(filter.measured_holes()) +
+                     " unsampled pixels filled by each band's own pull-push (not the whole frame's: those pixels may differ)");
 
-  Image out(w, h, 3);
-  try {
     for (int b = 0; b < plan.bands; ++b) {
       Roi rows;
       int r0 = 0;

@@ -57,11 +57,6 @@ struct BandPlan {
 // Bands of `band_rows` (rounded up to kBandAlign) over a frame of `height` rows.
 BandPlan plan_bands(int height, int band_rows, int halo);
 
-// The bytes a band of width x rows takes while filtered, per pixel read (input passes as
-// float plus the filter's working planes): a measured bound (bench/, README), for
-// --max-memory.
-double band_bytes_per_pixel(const Filter& filter, int input_channels);
-
 // Output rows per band that keep the whole run under max_bytes: the output (RGB float and
 // alpha) is held for the whole frame, the statistics pass's values while it runs; the rest is
 // one band with its halo.
@@ -78,8 +73,8 @@ struct TiledOptions {
 };
 
 // The filter (committed, tileable: band_halo() >= 0) over every band of `source`: its RGB
-// result, equal to filter.execute() on the whole frame. `notes`: the filter's notes, each
-// once (the statistics pass's first, then the bands').
+// result, equal to filter.execute() on the whole frame. `notes`: the bands ("12 bands of 256
+// rows (halo 74)"), unsampled pixels filled per band if any, then the filter's notes, each once.
 Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options, std::vector<std::string>* notes = nullptr,
                 Frame* kept = nullptr);
 

@@ -15,6 +15,7 @@ class AtrousFilter : public Filter {
  public:
   AtrousFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
+  double band_work_bytes() const override { return 208; }
   // The 1D generating kernel for k_g = 3, 5 or 9 (sums to 1).
   static std::vector<float> generating_kernel(int kg);
 

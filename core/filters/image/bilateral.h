@@ -10,6 +10,7 @@ class BilateralFilter : public Filter {
  public:
   BilateralFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
+  double band_work_bytes() const override { return 192; }
 
  protected:
   void check_params() override;

@@ -9,6 +9,7 @@ class BoxFilter : public Filter {
  public:
   BoxFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
+  double band_work_bytes() const override { return 144; }
 
  protected:
   Roi reads(const Roi& roi, int width, int height) const override;

@@ -13,6 +13,7 @@ class GaussianFilter : public Filter {
  public:
   GaussianFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
+  double band_work_bytes() const override { return 184; }
 
  protected:
   void check_params() override;

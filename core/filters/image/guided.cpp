@@ -16,6 +16,7 @@
 #include "image/luminance.h"
 #include "kernels/noise_scale.h"
 #include "util/error.h"
+#include "util/median.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -71,15 +72,9 @@ void guided::gather_frame_noise(const Image& colour, const Roi& rows, int nthrea
 }
 
 guided::FrameNoise guided::frame_noise_of(std::vector<float>& rel, std::vector<float>& abs) {
-  auto median = [](std::vector<float>& v) {
-    if (v.empty()) return 0.0;
-    auto mid = v.begin() + std::ptrdiff_t(v.size() / 2);
-    std::nth_element(v.begin(), mid, v.end());
-    return double(*mid);
-  };
   FrameNoise fn;
-  fn.relative = median(rel);
-  const double a = median(abs);
+  fn.relative = upper_median(rel);
+  const double a = upper_median(abs);
   fn.level = fn.relative > 0.0 && std::isfinite(a / fn.relative) ? std::sqrt(a / fn.relative) : 0.0;
   return fn;
 }
@@ -234,8 +229,8 @@ void filter_d(Ctx& c, const std::vector<std::pair<int, int>>& groups, const std:
 
   // Bands of a height set by the radius and the roi alone (never by the thread
   // count): the same sums in the same order on any number of threads. Each band
-  // recomputes r coefficient rows past each of its ends, so bands are tall (at
-  // least 256 rows and 16r) but at most half the roi, to give two threads work.
+  // recomputes r coefficient rows past each of its ends, so bands are 16r rows (at
+  // least 64) on the image's grid (guided::band_rows).
   const int band_h = guided::band_rows(c.r);
   st.bands = (roi.y1 - (roi.y0 - roi.y0 % band_h) + band_h - 1) / band_h;
   // The mean colour sums only when some output pixel has no finite guide.

@@ -105,6 +105,8 @@ class GuidedFilter : public Filter {
  public:
   GuidedFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
+  double band_work_bytes() const override { return 192; }
+  double statistics_bytes() const override { return 8; }  // the noise values of its first statistics pass (two floats)
   const GuidedStats& stats() const { return stats_; }
 
   // The passes a guide choice reads ("normal_depth" -> normal, depth); colour-based

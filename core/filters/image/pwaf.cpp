@@ -15,6 +15,7 @@
 #include "kernels/pwaf_window.h"
 #include "prepare/outliers.h"
 #include "util/error.h"
+#include "util/median.h"
 #include "util/parallel.h"
 
 namespace mcr {
@@ -55,22 +56,13 @@ void adjacent_distances(const Image& im, const Roi& rows, std::vector<float>& d)
       const double t = double(a[c]) - double(b[c]);
       s += t * t;
     }
-    if (s > 0) d.push_back(std::sqrt(s));
+    if (s > 0) d.push_back(float(std::sqrt(s)));
   };
   for (int y = rows.y0; y < rows.y1; ++y)
     for (int x = 0; x < w; ++x) {
       if (x + 1 < w) dist(x, y, x + 1, y);
       if (y + 1 < h) dist(x, y, x, y + 1);
     }
-}
-
-// The median of the values (0 when there are none); reorders them. Kept as floats: a frame's
-// worth of them is what a tiled run holds between its passes (the median of the rounded
-// values is the rounded median: rounding keeps the order).
-double median_of(std::vector<float>& v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + std::ptrdiff_t(v.size() / 2), v.end());
-  return v[v.size() / 2];
 }
 
 // spacing: the frame's median adjacent distance when measured beforehand (a tiled run), else
@@ -91,7 +83,7 @@ Feature make_feature(const Pass* pass, double sigma, bool scale_by_spacing, doub
       std::vector<float> d;
       d.reserve(std::size_t(im.width()) * std::size_t(im.height()) * 2);
       adjacent_distances(im, Roi::all(im.width(), im.height()), d);
-      if (!d.empty()) scale = median_of(d);
+      if (!d.empty()) scale = upper_median(d);
     }
   }
   const double s = sigma * scale;
@@ -186,8 +178,8 @@ void PwafFilter::measure_band(const Frame& band, const Image& colour, const Roi&
 }
 
 void PwafFilter::fix_statistics() {
-  fixed_spacing_ = median_of(measured_spacing_);
-  fixed_rho_median_ = median_of(measured_rho_);
+  fixed_spacing_ = upper_median(measured_spacing_);
+  fixed_rho_median_ = upper_median(measured_rho_);
   drop_measured();
 }
 
@@ -375,7 +367,7 @@ void PwafFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       sorted.reserve(rho.size());
       for (std::size_t i = 0; i < rho.size(); ++i)
         if (valid[i] && std::isfinite(rho[i])) sorted.push_back(float(rho[i]));
-      median = median_of(sorted);
+      median = upper_median(sorted);
     }
     stats_.median_rel_variance = median;
     const double rho_max = variance_max * median;

@@ -50,6 +50,8 @@ class PwafFilter : public Filter {
  public:
   PwafFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
+  double band_work_bytes() const override { return 200; }
+  double statistics_bytes() const override { return 12; }  // its spacings and relative variances (three floats)
   const PwafStats& stats() const { return stats_; }
 
  protected:
