@@ -14,7 +14,7 @@ JOBS=${JOBS:-$(nproc)}
 PACKAGES=(
   cmake g++ ninja-build pkg-config
   libopenimageio-dev openimageio-tools python3-openimageio
-  libopenexr-dev libopencolorio-dev
+  libopenexr-dev libdeflate-dev libopencolorio-dev
   libtbb-dev libeigen3-dev libcli11-dev nlohmann-json3-dev
   libembree-dev  # Embree 3: the light-field sample generators (samples/lightfield)
   libgtest-dev libbenchmark-dev

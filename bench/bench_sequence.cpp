@@ -1,8 +1,10 @@
-// A sequence through the file pipeline, serial against pipelined (issue 19, point 4): frames
+// A sequence through the file pipeline, before against now (issue 19, point 4): frames
 // per second of `mcrecon denoise` over a 1280x720, 28-channel, half-float zip EXR sequence
 // (the `anim` sample's frames resized, with noise added so the files compress like renders:
-// ~37 MB each), read -> filter -> write one after the other, then with the next frame's read
-// and the last frame's write overlapping the filter (DenoiseSession::run_sequence).
+// ~37 MB each), read -> filter -> write one after the other with every EXR through OpenImageIO
+// (zlib inside OpenEXR 3.1: the path before), then through the scanline I/O (libdeflate), then
+// with the next frame's read and the last frame's write overlapping the filter
+// (DenoiseSession::run_sequence).
 //
 //   mcrecon_bench_sequence [--frames N] [--repeat N] [--filter NAME] [--keep DIR]
 //
@@ -12,7 +14,7 @@
 // Then the output compressions' cost: one filtered frame written with each (best of `repeat`),
 // milliseconds and megabytes, so `--compression` can be chosen knowing what it costs.
 //
-// Both paths run in one process, alternating, best of `repeat`; the machine may be shared, so
+// The paths run in one process, alternating, best of `repeat`; the machine may be shared, so
 // the load average is printed before and after.
 #include <OpenImageIO/imagebuf.h>
 #include <OpenImageIO/imagebufalgo.h>
@@ -29,6 +31,7 @@
 
 #include <unistd.h>
 
+#include "io/exr_scanline_io.h"
 #include "io/sample_manifest.h"
 #include "io/sequence.h"
 #include "pipeline/denoise_session.h"
@@ -81,26 +84,40 @@ int main(int argc, char** argv) {
               frames, double(fs::file_size(sequence_path(input, 1))) / 1e6, filter.c_str(), load_average().c_str());
   std::vector<DenoiseSession::Job> jobs;
   for (int f = 1; f <= frames; ++f) jobs.push_back({sequence_path(input, f), sequence_path(output, f), ReadOptions{}});
-  double best[2] = {1e30, 1e30};
-  StageTimes stages[2];
+  // Three ways, alternating within each repeat: the serial path with every EXR through
+  // OpenImageIO (the product before issue 19's point 4), the serial path with the scanline I/O
+  // (io/exr_scanline_io.h), and the pipelined path with it (the default).
+  struct Way {
+    const char* label;
+    bool scanline_io, piped;
+  };
+  const Way ways[3] = {{"serial, OpenImageIO I/O (before)", false, false},
+                       {"serial, scanline I/O", true, false},
+                       {"pipelined, scanline I/O (default)", true, true}};
+  double best[3] = {1e30, 1e30, 1e30};
+  StageTimes stages[3];
   for (int r = 0; r < repeat; ++r)
-    for (int piped = 0; piped < 2; ++piped) {
+    for (int w = 0; w < 3; ++w) {
+      set_exr_scanline_io(ways[w].scanline_io);
       DenoiseSession session(filter, {});
       StageTimes sum;
       const auto t0 = std::chrono::steady_clock::now();
-      session.run_sequence(jobs, WriteOptions{}, ExecOptions{}, piped == 1, [&](std::size_t, const StageTimes& t) {
+      session.run_sequence(jobs, WriteOptions{}, ExecOptions{}, ways[w].piped, [&](std::size_t, const StageTimes& t) {
         sum.read_ms += t.read_ms / frames;
         sum.filter_ms += t.filter_ms / frames;
         sum.write_ms += t.write_ms / frames;
       });
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      if (s < best[piped]) best[piped] = s, stages[piped] = sum;
+      if (s < best[w]) best[w] = s, stages[w] = sum;
     }
-  for (int piped = 0; piped < 2; ++piped)
-    std::printf("%-9s %6.2f frames/s (%5.0f ms per frame; stages read %.0f, filter %.0f, write %.0f ms)\n",
-                piped ? "pipelined" : "serial", frames / best[piped], 1000 * best[piped] / frames,
-                stages[piped].read_ms, stages[piped].filter_ms, stages[piped].write_ms);
-  std::printf("pipelined / serial: %.2fx frames per second; load after: %s\n", best[0] / best[1], load_average().c_str());
+  set_exr_scanline_io(true);
+  for (int w = 0; w < 3; ++w)
+    std::printf("%-34s %6.2f frames/s (%5.0f ms per frame; stages read %.0f, filter %.0f, write %.0f ms)\n",
+                ways[w].label, frames / best[w], 1000 * best[w] / frames, stages[w].read_ms, stages[w].filter_ms,
+                stages[w].write_ms);
+  std::printf("pipelined scanline I/O / serial OpenImageIO I/O: %.2fx frames per second (pipelining alone %.2fx, "
+              "the I/O alone %.2fx); load after: %s\n",
+              best[0] / best[2], best[1] / best[2], best[0] / best[1], load_average().c_str());
   {
     DenoiseSession session(filter, {});
     const std::string one = (dir / "out" / "compression.exr").string();

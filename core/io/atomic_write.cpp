@@ -230,6 +230,12 @@ void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std:
   });
 }
 
+void write_fd_atomic(const std::string& path, const std::function<int(int fd)>& body) {
+  write_via_temp(path, [&](TempFile& tmp) {
+    if (const int err = body(tmp.fd())) tmp.fail(err);
+  });
+}
+
 void write_text_atomic(const std::string& text, const std::string& path) {
   write_via_temp(path, [&](TempFile& tmp) {
     std::size_t done = 0;

@@ -6,6 +6,7 @@
 // the visible part cut so the whole fits NAME_MAX. Two runs writing one output each
 // write their own temp and rename it: both succeed, the last rename wins, and the
 // output is always one complete file (rename is atomic), never a mix.
+#include <functional>
 #include <string>
 
 #include <OpenImageIO/imagebuf.h>
@@ -20,6 +21,10 @@ namespace mcr {
 // Removes the temps of earlier runs on this target whose process is gone.
 void write_atomic(const OIIO::ImageBuf& buf, const std::string& path, const std::string& format = "",
                   OIIO::TypeDesc dtype = OIIO::TypeUnknown);
+
+// The same for a writer of its own: body writes the file to the descriptor (the temp's, open
+// for writing) and returns 0, or the errno of its first failed write (reported naming path).
+void write_fd_atomic(const std::string& path, const std::function<int(int fd)>& body);
 
 // The same for a text file (reports such as results.json).
 void write_text_atomic(const std::string& text, const std::string& path);

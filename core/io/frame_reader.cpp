@@ -15,6 +15,7 @@
 #include "image/lightfield.h"
 #include "io/half_buffers.h"
 #include "io/channel_roles.h"
+#include "io/exr_scanline_io.h"
 #include "io/input_limits.h"
 #include "io/spec_window.h"
 #include "util/error.h"
@@ -38,7 +39,14 @@ struct RawImage {
   std::vector<float> pixels;
   // The native form, used instead of pixels when not empty: packed pixels of `stride` bytes,
   // channel c at byte offset[c], half when is_half[c], else float.
-  std::vector<unsigned char> native;
+  // Not zeroed when sized (every byte is decoded into it): a 50 MB frame's memset and page
+  // faults on one thread would be a tenth of the read.
+  struct NoInit : std::allocator<unsigned char> {
+    template <class U> struct rebind { using other = NoInit; };
+    template <class U> void construct(U* p) noexcept { ::new (static_cast<void*>(p)) U; }
+    using std::allocator<unsigned char>::allocator;
+  };
+  std::vector<unsigned char, NoInit> native;
   std::vector<std::size_t> offset;
   std::vector<char> is_half;
   std::size_t stride = 0;
@@ -46,19 +54,6 @@ struct RawImage {
   std::shared_ptr<const LightField> lightfield;
   bool independent_samples = false;  // deep, no alpha, not a light field: the per-sample convention
 };
-
-// Native channel c of pixel px as float.
-inline float native_value(const RawImage& raw, std::size_t px, std::size_t c) {
-  const unsigned char* p = raw.native.data() + px * raw.stride + raw.offset[c];
-  if (raw.is_half[c]) {
-    Imath::half h;
-    std::memcpy(&h, p, sizeof h);
-    return float(h);
-  }
-  float f;
-  std::memcpy(&f, p, sizeof f);
-  return f;
-}
 
 bool half_or_float(const ImageSpec& spec) {
   for (int c = 0; c < spec.nchannels; ++c) {
@@ -183,6 +178,8 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
         raw.stride += spec.channelformat(c).size();
       }
       raw.native.resize(std::size_t(spec.width) * spec.height * raw.stride);
+      const NativeLayout layout{raw.names, raw.offset, raw.is_half, raw.stride};
+      if (read_exr_scanlines(path, spec.width, spec.height, layout, raw.native.data())) return;
       if (!in.read_image(0, 0, 0, spec.nchannels, TypeUnknown, raw.native.data()))
         throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' " + part_label(spec, part) +
                                           " (truncated or corrupt?): " + in.geterror());
@@ -245,27 +242,57 @@ RawImage read_raw(const std::string& path) {
   return raw;
 }
 
-Pass make_pass(const RawImage& raw, const std::string& path, const std::string& group_name, const RoleMatch& m) {
+// A pass's name, role and channels, its image sized but not yet filled (fill_passes).
+Pass pass_shell(const RawImage& raw, const std::string& path, const std::string& group_name, const RoleMatch& m) {
   Pass p;
   p.role = m.role;
   p.name = group_name;
   p.source = path;
   p.space = m.space;
   p.priority = m.priority;
-  const int nc = int(m.indices.size());
   for (int i : m.indices) p.channels.push_back(raw.names[std::size_t(i)]);
-  p.image = Image(raw.width, raw.height, nc);
-  float* dst = p.image.data();
-  // Rows in parallel: a strided gather out of a wide file (28 channels, 720p) is memory-bound.
+  p.image = Image(raw.width, raw.height, int(m.indices.size()));
+  return p;
+}
+
+// Fills passes[k] with the raw channels indices[k], all passes in one sweep over the rows: a
+// strided gather out of a wide file (28 channels, 720p) is memory-bound, and a row stays in
+// cache while every pass takes its channels from it.
+void fill_passes(const RawImage& raw, const std::vector<Pass*>& passes, const std::vector<const std::vector<int>*>& indices) {
   const std::size_t w = std::size_t(raw.width);
   const std::size_t nin = raw.names.size();
   parallel_rows(0, raw.height, 0, [&](int y) {
-    for (std::size_t px = std::size_t(y) * w; px < std::size_t(y + 1) * w; ++px)
-      for (int c = 0; c < nc; ++c) {
-        const std::size_t ch = std::size_t(m.indices[std::size_t(c)]);
-        dst[px * nc + c] = raw.native.empty() ? raw.pixels[px * nin + ch] : native_value(raw, px, ch);
+    const std::size_t row = std::size_t(y) * w;
+    for (std::size_t k = 0; k < passes.size(); ++k) {
+      const std::vector<int>& from = *indices[k];
+      const std::size_t nc = from.size();
+      float* out = passes[k]->image.data() + row * nc;
+      for (std::size_t c = 0; c < nc; ++c) {  // a channel at a time, its type known outside the loop
+        const std::size_t ch = std::size_t(from[c]);
+        if (raw.native.empty()) {
+          const float* in = raw.pixels.data() + row * nin + ch;
+          for (std::size_t x = 0; x < w; ++x) out[x * nc + c] = in[x * nin];
+          continue;
+        }
+        const std::size_t stride = raw.stride;
+        const unsigned char* in = raw.native.data() + row * stride + raw.offset[ch];
+        if (raw.is_half[ch]) {
+          for (std::size_t x = 0; x < w; ++x) {
+            Imath::half h;
+            std::memcpy(&h, in + x * stride, sizeof h);
+            out[x * nc + c] = float(h);
+          }
+        } else {
+          for (std::size_t x = 0; x < w; ++x) std::memcpy(out + x * nc + c, in + x * stride, sizeof(float));
+        }
       }
+    }
   });
+}
+
+Pass make_pass(const RawImage& raw, const std::string& path, const std::string& group_name, const RoleMatch& m) {
+  Pass p = pass_shell(raw, path, group_name, m);
+  fill_passes(raw, {&p}, {&m.indices});
   return p;
 }
 
@@ -368,6 +395,7 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
   std::vector<std::string> search = {frame.layer};
   if (!frame.layer.empty()) search.push_back("");
   if (frame.layer != "Composite") search.push_back("Composite");
+  std::vector<std::vector<int>> taken;  // each pass's raw channels, filled below in one sweep
   for (const std::string& layer : search) {
     std::set<Role> had;
     for (const Pass& p : frame.passes) had.insert(p.role);
@@ -375,9 +403,16 @@ Frame frame_from_raw(const RawImage& raw, const std::string& path, const ReadOpt
       if (g.layer != layer) continue;
       for (const RoleMatch& m : classify_group(g)) {
         if (layer != frame.layer && had.count(m.role)) continue;
-        frame.passes.push_back(make_pass(raw, path, g.name(), m));
+        frame.passes.push_back(pass_shell(raw, path, g.name(), m));
+        taken.push_back(m.indices);
       }
     }
+  }
+  {
+    std::vector<Pass*> passes;
+    std::vector<const std::vector<int>*> indices;
+    for (std::size_t k = 0; k < taken.size(); ++k) passes.push_back(&frame.passes[k]), indices.push_back(&taken[k]);
+    fill_passes(raw, passes, indices);
   }
   for (const PassOverride& o : options.overrides) {
     Pass p = resolve_override(raw, groups, frame.layer, path, o);

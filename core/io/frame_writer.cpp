@@ -7,6 +7,7 @@
 
 #include "io/atomic_write.h"
 #include "io/exr_output.h"
+#include "io/exr_scanline_io.h"
 #include "io/output_format.h"
 #include "io/spec_window.h"
 #include "util/error.h"
@@ -148,6 +149,14 @@ void write_result(const std::string& path, const Image& rgb, const Frame& input,
     const int sc = s.image->channels();
     const float* d = s.image->data();
     for (std::size_t i = 0; i < n; ++i) pixels[i * nc + c] = d[i * sc + s.channel];
+  }
+  if (exr_scanline_compression(options.compression)) {
+    std::vector<std::pair<std::string, std::string>> attributes = options.attributes;
+    write_fd_atomic(path, [&](int fd) {
+      return write_exr_scanlines(fd, path, input.width, input.height, input.window, names, pixels.data(),
+                                 options.compression, attributes);
+    });
+    return;
   }
   const ImageBuf buf(spec, pixels.data());  // wraps the pixels: no second copy of a huge frame
   write_atomic(buf, path, "openexr");
