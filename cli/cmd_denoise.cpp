@@ -5,6 +5,8 @@
 #include <memory>
 #include <regex>
 
+#include <tbb/info.h>
+
 #include "commands.h"
 #include "io/atomic_write.h"
 #include "io/exr_output.h"
@@ -26,6 +28,7 @@ struct DenoiseArgs {
   bool keep_passes = false, keep_components = false, timings = false, verbose = false, resume = false;
   bool accumulate = false;  // the accumulation stage before the filter
   bool serial = false;      // --serial: no overlap of read, filter and write
+  bool pipelined = false;   // --pipelined: overlap them whatever the core count
   int threads = 0;
   int warmup = -1;  // --warmup N; -1: not given
   int max_memory = 0, band_rows = 0;  // --max-memory MB, --band-rows N: a single frame in bands
@@ -198,8 +201,12 @@ int run_denoise(const DenoiseArgs& a) {
     j.read.second_half = half_of(job.frame);
     session_jobs.push_back(std::move(j));
   }
-  // Sequences overlap reading, filtering and writing unless --serial; one frame has nothing to overlap.
-  session.run_sequence(session_jobs, wo, eo, seq && !a.serial, [&](std::size_t i, const StageTimes& t) {
+  // Sequences overlap reading, filtering and writing where there are cores to spare: on 2 every
+  // stage already uses both, and the overlap ran 5-7% slower than one frame after the other
+  // (mcrecon_bench_sequence). One frame has nothing to overlap.
+  const int cores = tbb::info::default_concurrency();
+  const bool spare = (a.threads > 0 ? std::min(a.threads, cores) : cores) >= 4;
+  session.run_sequence(session_jobs, wo, eo, seq && !a.serial && (a.pipelined || spare), [&](std::size_t i, const StageTimes& t) {
     const std::string& in = session_jobs[i].input;
     const std::string& out = session_jobs[i].output;
     sum.read_ms += t.read_ms;
@@ -268,9 +275,13 @@ Run add_denoise(CLI::App& app) {
       ->check(CLI::Range(0, 1000000));
   app.add_flag("--accumulate", a->accumulate,
                "temporally accumulate the noisy colour (BMFR phase I: needs world position, normal; uses motion) before the filter");
-  app.add_flag("--serial", a->serial,
-               "sequences: read, filter and write one frame after the other (by default the next frame is read and "
-               "the last written while one is filtered: faster, three frames in memory instead of one)");
+  auto* serial = app.add_flag("--serial", a->serial,
+                              "sequences: read, filter and write one frame after the other (the default with fewer "
+                              "than 4 threads, where every stage already uses them all)");
+  app.add_flag("--pipelined", a->pipelined,
+               "sequences: read the next frame and write the last while one is filtered (the default with 4 threads "
+               "or more; three frames in memory instead of one; hides slow storage)")
+      ->excludes(serial);
   app.add_option("--max-memory", a->max_memory,
                  "one frame in bands of rows, sized to stay under MB megabytes (like OIDN's maxMemoryMB): only the "
                  "passes the filter reads are decoded, a band at a time; the same pixels as the whole frame")

@@ -150,7 +150,7 @@ class BatchTest(unittest.TestCase):
 
     def test_pipelined_run_equals_the_serial_one(self):
         piped, serial = self.dir("piped"), self.dir("serial")
-        proc = self.bmfr(piped, "1-5", "--timings")
+        proc = self.bmfr(piped, "1-5", "--timings", "--pipelined")
         lines = [ln for ln in proc.stderr.splitlines() if "o_000" in ln and "filter " in ln]
         self.assertEqual([ln.split("o_")[1][:4] for ln in lines], ["0001", "0002", "0003", "0004", "0005"])
         self.bmfr(serial, "1-5", "--serial")
@@ -167,7 +167,7 @@ class BatchTest(unittest.TestCase):
             f.write(data[:len(data) // 2])
         out = self.dir("out")
         proc = tu.run_cli("denoise", src, "-o", os.path.join(out, "o_####.exr"), "-f", "box", "--frames", "1-5",
-                          check=False)
+                          "--pipelined", check=False)
         self.assertNotEqual(proc.returncode, 0)
         self.assertIn("s_0003.exr", proc.stderr)
         self.assertEqual(os.listdir(out).__len__(), len(written(out)))  # no temp file left
