@@ -202,8 +202,8 @@ int run_denoise(const DenoiseArgs& a) {
     session_jobs.push_back(std::move(j));
   }
   // Sequences overlap reading, filtering and writing where there are cores to spare: on 2 every
-  // stage already uses both, and the overlap ran 5-7% slower than one frame after the other
-  // (mcrecon_bench_sequence). One frame has nothing to overlap.
+  // stage already uses both, and the overlap gained nothing (0.98x-1.02x, mcrecon_bench_sequence)
+  // for three frames in memory instead of one. One frame has nothing to overlap.
   const int cores = tbb::info::default_concurrency();
   const bool spare = (a.threads > 0 ? std::min(a.threads, cores) : cores) >= 4;
   session.run_sequence(session_jobs, wo, eo, seq && !a.serial && (a.pipelined || spare), [&](std::size_t i, const StageTimes& t) {
