@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cstring>
 
+#include "io/exr_scanline_io.h"
 #include "io/input_limits.h"
+#include "io/native_pixels.h"
 #include "io/spec_window.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -57,6 +59,10 @@ struct FileBands::Impl {
   Frame last;  // its last rows only: [last_y0, last_y1)
   int last_y0 = 0, last_y1 = 0, keep = 0;
   double read_ms = 0;
+  // A scanline zip, zips or uncompressed file of half and float channels: read in its own
+  // types through io/exr_scanline_io.h (libdeflate), as read_frame reads it; else OpenImageIO.
+  std::unique_ptr<ExrScanlineReader> scan;
+  NativeLayout native;
 };
 
 FileBands::FileBands(const std::string& path, const ReadOptions& options, const std::vector<Role>& roles)
@@ -90,6 +96,18 @@ FileBands::FileBands(const std::string& path, const ReadOptions& options, const 
       throw Error(Errc::Internal, "band reader: pass '" + p.name + "' of '" + path + "' has another channel count");
     m.sources.push_back(std::move(src));
     m.layout.passes.push_back(std::move(p));
+  }
+  bool half_or_float = m.spec.tile_width == 0;
+  for (int c = 0; c < nch && half_or_float; ++c) {
+    const TypeDesc t = m.spec.channelformat(c);
+    half_or_float = t == TypeHalf || t == TypeFloat;
+    m.native.offset.push_back(m.native.stride);
+    m.native.is_half.push_back(t == TypeHalf);
+    m.native.stride += t.size();
+  }
+  if (half_or_float) {
+    m.native.names = names;
+    m.scan = ExrScanlineReader::open(path, m.spec.width, m.spec.height, m.native);
   }
 }
 
@@ -131,13 +149,34 @@ Frame FileBands::rows(int y0, int y1) {
   }
   // Scanline files in chunks of kChunkRows; tiled ones a row of tiles at a time (OpenImageIO
   // reads tiles only on their grid), of which the rows wanted are copied.
+  // The scanline reader's windows start on its chunk grid (each zip block decoded once).
   const int tile_h = m.spec.tile_width > 0 ? std::max(1, m.spec.tile_height) : 0;
+  const int grid = tile_h > 0 ? tile_h : m.scan ? m.scan->chunk_rows() : 1;
   const int chunk_rows = tile_h > 0 ? tile_h : kChunkRows;
-  std::vector<float> chunk(std::size_t(w) * std::size_t(nch) * std::size_t(chunk_rows));
+  std::vector<float> chunk(m.scan ? 0 : std::size_t(w) * std::size_t(nch) * std::size_t(chunk_rows));
+  std::vector<unsigned char> native(m.scan ? std::size_t(w) * m.native.stride * std::size_t(chunk_rows) : 0);
   for (int c0 = from; c0 < y1;) {
-    const int t0 = tile_h > 0 ? c0 / tile_h * tile_h : c0;  // the chunk's first row in the file
+    const int t0 = c0 / grid * grid;  // the chunk's first row in the file
     const int t1 = std::min(m.spec.height, t0 + chunk_rows);
     const int c1 = std::min(y1, t1);
+    if (m.scan) {
+      m.scan->read(c0, c1, native.data());
+      for (std::size_t k = 0; k < f.passes.size(); ++k) {
+        Image& im = f.passes[k].image;
+        const std::vector<int>& src = m.sources[k];
+        const std::size_t pc = std::size_t(im.channels());
+        parallel_rows(c0, c1, 0, [&](int y) {
+          const unsigned char* s = native.data() + std::size_t(y - c0) * std::size_t(w) * m.native.stride;
+          for (std::size_t c = 0; c < pc; ++c) {
+            const std::size_t ch = std::size_t(src[c]);
+            native_channel_to_float(s + m.native.offset[ch], m.native.stride, m.native.is_half[ch], std::size_t(w),
+                                    im.pixel(0, y - y0) + c, pc);
+          }
+        });
+      }
+      c0 = c1;
+      continue;
+    }
     const bool ok = tile_h > 0 ? m.in->read_tiles(0, 0, m.spec.x, m.spec.x + w, m.spec.y + t0, m.spec.y + t1, m.spec.z,
                                                    m.spec.z + 1, 0, nch, TypeDesc::FLOAT, chunk.data())
                                : m.in->read_scanlines(0, 0, m.spec.y + t0, m.spec.y + t1, 0, 0, nch, TypeDesc::FLOAT, chunk.data());

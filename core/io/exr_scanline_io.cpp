@@ -10,6 +10,7 @@
 #include <cstring>
 #include <ctime>
 #include <fstream>
+#include <memory>
 #include <mutex>
 
 #include "io/exr_zip.h"
@@ -145,49 +146,70 @@ bool exr_scanline_io() {
   return v == 1;
 }
 
-bool read_exr_scanlines(const std::string& path, int width, int height, const NativeLayout& layout, unsigned char* dst) {
-  if (!exr_scanline_io()) return false;
-  const exr_context_initializer_t init = initializer(nullptr);
+struct ExrScanlineReader::Impl {
+  std::string path;
   Context c;
-  if (exr_start_read(&c.ctxt, path.c_str(), &init) != EXR_ERR_SUCCESS) return false;  // OpenImageIO says why
+  exr_compression_t comp = EXR_COMPRESSION_NONE;
+  exr_attr_box2i_t dw{};
+  std::vector<Plane> planes;
+  std::size_t line_bytes = 0, stride = 0;
+  int width = 0, lines = 1, chunks = 0;
+  std::vector<std::uint64_t> table;
+};
+
+std::unique_ptr<ExrScanlineReader> ExrScanlineReader::open(const std::string& path, int width, int height,
+                                                           const NativeLayout& layout) {
+  if (!exr_scanline_io()) return nullptr;
+  auto m = std::make_unique<Impl>();
+  m->path = path;
+  m->width = width;
+  m->stride = layout.stride;
+  const exr_context_initializer_t init = initializer(nullptr);
+  if (exr_start_read(&m->c.ctxt, path.c_str(), &init) != EXR_ERR_SUCCESS) return nullptr;  // OpenImageIO says why
   int parts = 0;
   exr_storage_t storage;
-  exr_compression_t comp;
-  exr_attr_box2i_t dw;
   const exr_attr_chlist_t* channels = nullptr;
-  if (exr_get_count(c.ctxt, &parts) != EXR_ERR_SUCCESS || parts != 1 ||
-      exr_get_storage(c.ctxt, 0, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_SCANLINE ||
-      exr_get_compression(c.ctxt, 0, &comp) != EXR_ERR_SUCCESS || !handled(comp) ||
-      exr_get_data_window(c.ctxt, 0, &dw) != EXR_ERR_SUCCESS || exr_get_channels(c.ctxt, 0, &channels) != EXR_ERR_SUCCESS)
-    return false;
-  if (int64_t(dw.max.x) - dw.min.x + 1 != width || int64_t(dw.max.y) - dw.min.y + 1 != height) return false;
-  if (!channels || std::size_t(channels->num_channels) != layout.names.size()) return false;
-  std::vector<Plane> planes;
-  std::size_t line_bytes = 0;
+  exr_context_t ctxt = m->c.ctxt;
+  if (exr_get_count(ctxt, &parts) != EXR_ERR_SUCCESS || parts != 1 ||
+      exr_get_storage(ctxt, 0, &storage) != EXR_ERR_SUCCESS || storage != EXR_STORAGE_SCANLINE ||
+      exr_get_compression(ctxt, 0, &m->comp) != EXR_ERR_SUCCESS || !handled(m->comp) ||
+      exr_get_data_window(ctxt, 0, &m->dw) != EXR_ERR_SUCCESS || exr_get_channels(ctxt, 0, &channels) != EXR_ERR_SUCCESS)
+    return nullptr;
+  if (int64_t(m->dw.max.x) - m->dw.min.x + 1 != width || int64_t(m->dw.max.y) - m->dw.min.y + 1 != height) return nullptr;
+  if (!channels || std::size_t(channels->num_channels) != layout.names.size()) return nullptr;
   for (int k = 0; k < channels->num_channels; ++k) {
     const exr_attr_chlist_entry_t& e = channels->entries[k];
-    if (e.x_sampling != 1 || e.y_sampling != 1) return false;
-    if (e.pixel_type != EXR_PIXEL_HALF && e.pixel_type != EXR_PIXEL_FLOAT) return false;
+    if (e.x_sampling != 1 || e.y_sampling != 1) return nullptr;
+    if (e.pixel_type != EXR_PIXEL_HALF && e.pixel_type != EXR_PIXEL_FLOAT) return nullptr;
     const std::string name(e.name.str, std::size_t(e.name.length));
     const auto at = std::find(layout.names.begin(), layout.names.end(), name);
-    if (at == layout.names.end()) return false;
+    if (at == layout.names.end()) return nullptr;
     const std::size_t i = std::size_t(at - layout.names.begin());
-    if (bool(layout.is_half[i]) != (e.pixel_type == EXR_PIXEL_HALF)) return false;
-    planes.push_back({e.pixel_type == EXR_PIXEL_HALF ? 2u : 4u, layout.offset[i]});
-    line_bytes += planes.back().bytes * std::size_t(width);
+    if (bool(layout.is_half[i]) != (e.pixel_type == EXR_PIXEL_HALF)) return nullptr;
+    m->planes.push_back({e.pixel_type == EXR_PIXEL_HALF ? 2u : 4u, layout.offset[i]});
+    m->line_bytes += m->planes.back().bytes * std::size_t(width);
   }
-
-  const int lines = lines_per_chunk(comp);
-  const int chunks = (height + lines - 1) / lines;
+  m->lines = lines_per_chunk(m->comp);
+  m->chunks = (height + m->lines - 1) / m->lines;
   int32_t counted = 0;
-  if (exr_get_chunk_count(c.ctxt, 0, &counted) != EXR_ERR_SUCCESS || counted != chunks) return false;
-  const std::string where = "cannot read pixels of '" + path + "' (truncated or corrupt?): ";
+  if (exr_get_chunk_count(ctxt, 0, &counted) != EXR_ERR_SUCCESS || counted != m->chunks) return nullptr;
   exr_chunk_info_t first;
-  if (exr_read_scanline_chunk_info(c.ctxt, 0, dw.min.y, &first) != EXR_ERR_SUCCESS)  // loads the chunk table
-    throw Error(Errc::ReadFailed, where + t_message);
-  const std::vector<std::uint64_t> table = stored_offsets(path, chunks);
-  if (table.empty()) return false;
+  if (exr_read_scanline_chunk_info(ctxt, 0, m->dw.min.y, &first) != EXR_ERR_SUCCESS)  // loads the chunk table
+    throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' (truncated or corrupt?): " + t_message);
+  m->table = stored_offsets(path, m->chunks);
+  if (m->table.empty()) return nullptr;
+  return std::unique_ptr<ExrScanlineReader>(new ExrScanlineReader(std::move(m)));
+}
 
+ExrScanlineReader::ExrScanlineReader(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+ExrScanlineReader::~ExrScanlineReader() = default;
+
+int ExrScanlineReader::chunk_rows() const { return impl_->lines; }
+
+void ExrScanlineReader::read(int y0, int y1, unsigned char* dst) {
+  Impl& m = *impl_;
+  if (y0 < 0 || y1 > m.dw.max.y - m.dw.min.y + 1 || y0 >= y1)
+    throw Error(Errc::Internal, "scanline reader: rows " + std::to_string(y0) + ".." + std::to_string(y1) + " outside '" + m.path + "'");
   std::atomic<bool> failed{false};
   std::string failure;
   std::mutex failure_lock;
@@ -195,33 +217,43 @@ bool read_exr_scanlines(const std::string& path, int width, int height, const Na
     const std::lock_guard<std::mutex> hold(failure_lock);
     if (!failed.exchange(true)) failure = "rows from " + std::to_string(y) + ": " + why;
   };
-  parallel_rows(0, chunks, 0, [&](int k) {
+  const std::size_t row_bytes = std::size_t(m.width) * m.stride;
+  parallel_rows(y0 / m.lines, (y1 - 1) / m.lines + 1, 0, [&](int k) {
     if (failed.load()) return;
-    const int y = dw.min.y + k * lines;
-    const int rows = std::min(lines, dw.max.y + 1 - y);
-    const std::size_t expect = std::size_t(rows) * line_bytes;
+    const int y = m.dw.min.y + k * m.lines;
+    const int rows = std::min(m.lines, m.dw.max.y + 1 - y);
+    const std::size_t expect = std::size_t(rows) * m.line_bytes;
     exr_chunk_info_t ci;
-    if (exr_read_scanline_chunk_info(c.ctxt, 0, y, &ci) != EXR_ERR_SUCCESS) return fail(y, t_message);
-    if (ci.data_offset != table[std::size_t(k)] + 8)  // after the chunk's row and size fields
+    if (exr_read_scanline_chunk_info(m.c.ctxt, 0, y, &ci) != EXR_ERR_SUCCESS) return fail(y, t_message);
+    if (ci.data_offset != m.table[std::size_t(k)] + 8)  // after the chunk's row and size fields
       return fail(y, "the chunk offset table is damaged (chunk " + std::to_string(k) + " at byte " +
-                         std::to_string(table[std::size_t(k)]) + ")");
+                         std::to_string(m.table[std::size_t(k)]) + ")");
     // A chunk holds what the header says, stored smaller or raw: nothing bigger is allocated.
     if (ci.start_y != y || ci.height != rows || ci.unpacked_size != expect || ci.packed_size == 0 || ci.packed_size > expect)
       return fail(y, "chunk of " + std::to_string(ci.packed_size) + " bytes where " + std::to_string(expect) +
                          " raw bytes are expected");
     thread_local std::vector<unsigned char> packed, raw;
     packed.resize(ci.packed_size);
-    if (exr_read_chunk(c.ctxt, 0, &ci, packed.data()) != EXR_ERR_SUCCESS) return fail(y, t_message);
+    if (exr_read_chunk(m.c.ctxt, 0, &ci, packed.data()) != EXR_ERR_SUCCESS) return fail(y, t_message);
     const unsigned char* data = packed.data();
     if (ci.packed_size < expect) {
-      if (comp == EXR_COMPRESSION_NONE) return fail(y, "short uncompressed chunk");
+      if (m.comp == EXR_COMPRESSION_NONE) return fail(y, "short uncompressed chunk");
       raw.resize(expect);
       if (!exr_zip::decode(packed.data(), packed.size(), raw.data(), expect)) return fail(y, "zip data does not decode");
       data = raw.data();
     }
-    scatter(data, rows, width, planes, layout.stride, dst + std::size_t(k) * std::size_t(lines) * std::size_t(width) * layout.stride);
+    // The chunk's rows inside [y0, y1) (a read need not start or end on the chunk grid).
+    const int r0 = std::max(y0, k * m.lines), r1 = std::min(y1, k * m.lines + rows);
+    scatter(data + std::size_t(r0 - k * m.lines) * m.line_bytes, r1 - r0, m.width, m.planes, m.stride,
+            dst + std::size_t(r0 - y0) * row_bytes);
   });
-  if (failed.load()) throw Error(Errc::ReadFailed, where + failure);
+  if (failed.load()) throw Error(Errc::ReadFailed, "cannot read pixels of '" + m.path + "' (truncated or corrupt?): " + failure);
+}
+
+bool read_exr_scanlines(const std::string& path, int width, int height, const NativeLayout& layout, unsigned char* dst) {
+  const auto reader = ExrScanlineReader::open(path, width, height, layout);
+  if (!reader) return false;
+  reader->read(0, height, dst);
   return true;
 }
 

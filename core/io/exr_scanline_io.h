@@ -4,6 +4,7 @@
 // parallel. Renders (Blender writes zip) and mcrecon's own outputs are such files; every other
 // file goes through OpenImageIO as before. Same pixels, bit for bit, either way.
 #include <cstddef>
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -24,6 +25,26 @@ struct NativeLayout {
   std::vector<std::size_t> offset;
   std::vector<char> is_half;
   std::size_t stride = 0;
+};
+
+// A file of those opened to read rows, as often as needed (a frame read in bands).
+class ExrScanlineReader {
+ public:
+  // Null when the file is not one of the above, or its channels are not the layout's (half or
+  // float as laid out). Throws ReadFailed when its chunk table cannot be read.
+  static std::unique_ptr<ExrScanlineReader> open(const std::string& path, int width, int height, const NativeLayout& layout);
+  ~ExrScanlineReader();
+  // Rows per chunk: reads that start on a multiple of it decode each chunk once.
+  int chunk_rows() const;
+  // Rows [y0, y1) of the data window (0: its first row) into dst, (y1 - y0) rows of width
+  // pixels of layout.stride bytes. Throws ReadFailed on a chunk that does not decode (truncated
+  // or corrupt), naming the file and the row.
+  void read(int y0, int y1, unsigned char* dst);
+
+ private:
+  struct Impl;
+  explicit ExrScanlineReader(std::unique_ptr<Impl> impl);
+  std::unique_ptr<Impl> impl_;
 };
 
 // Reads all of `path`'s pixels (width x height, as OpenImageIO's header said) into dst when

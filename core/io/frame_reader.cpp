@@ -17,6 +17,7 @@
 #include "io/channel_roles.h"
 #include "io/exr_scanline_io.h"
 #include "io/input_limits.h"
+#include "io/native_pixels.h"
 #include "io/spec_window.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -274,17 +275,8 @@ void fill_passes(const RawImage& raw, const std::vector<Pass*>& passes, const st
           for (std::size_t x = 0; x < w; ++x) out[x * nc + c] = in[x * nin];
           continue;
         }
-        const std::size_t stride = raw.stride;
-        const unsigned char* in = raw.native.data() + row * stride + raw.offset[ch];
-        if (raw.is_half[ch]) {
-          for (std::size_t x = 0; x < w; ++x) {
-            Imath::half h;
-            std::memcpy(&h, in + x * stride, sizeof h);
-            out[x * nc + c] = float(h);
-          }
-        } else {
-          for (std::size_t x = 0; x < w; ++x) std::memcpy(out + x * nc + c, in + x * stride, sizeof(float));
-        }
+        native_channel_to_float(raw.native.data() + row * raw.stride + raw.offset[ch], raw.stride, raw.is_half[ch], w,
+                                out + c, nc);
       }
     }
   });

@@ -127,6 +127,27 @@ TEST(ExrScanlineIoTest, ReadsWhatOpenImageIoWritesBitForBit) {
     }
 }
 
+// Rows read a range at a time (bands) are the whole read's rows, from any row to any row.
+TEST(ExrScanlineIoTest, RowRangesAreTheWholeReadsRows) {
+  ScratchDir dir("mcrecon_exr_io");
+  const int w = 13, h = 53;
+  std::size_t stride = 0;
+  const std::vector<unsigned char> px = native_pixels(w, h, true, stride);
+  const std::size_t row = std::size_t(w) * stride;
+  for (const char* compression : {"zip", "zips"}) {
+    SCOPED_TRACE(compression);
+    write_with_oiio(dir.path("in.exr"), w, h, compression, px);
+    const auto reader = ExrScanlineReader::open(dir.path("in.exr"), w, h, layout_of(stride));
+    ASSERT_TRUE(reader);
+    EXPECT_EQ(reader->chunk_rows(), std::string(compression) == "zip" ? 16 : 1);
+    for (const auto& [y0, y1] : std::vector<std::pair<int, int>>{{0, 53}, {0, 1}, {5, 21}, {16, 32}, {15, 17}, {47, 53}, {52, 53}}) {
+      std::vector<unsigned char> got(std::size_t(y1 - y0) * row, 0xCD);
+      reader->read(y0, y1, got.data());
+      EXPECT_TRUE(std::equal(got.begin(), got.end(), px.begin() + std::ptrdiff_t(std::size_t(y0) * row))) << y0 << ".." << y1;
+    }
+  }
+}
+
 TEST(ExrScanlineIoTest, OtherFilesAreLeftToOpenImageIo) {
   ScratchDir dir("mcrecon_exr_io");
   std::size_t stride = 0;
