@@ -321,8 +321,9 @@ int write_exr_scanlines(int fd, const std::string& path, int width, int height, 
     const int lines = lines_per_chunk(comp);
     const int chunks = (height + lines - 1) / lines;
     const std::size_t line_bytes = std::size_t(width) * std::size_t(nc) * 4;
-    // Chunks compressed in parallel a batch of ~1024 rows at a time, written in order.
-    const int batch = std::max(1, 1024 / lines);
+    // Chunks compressed in parallel a batch of ~256 rows at a time (a 4096-wide RGBA batch holds
+    // 16 MB raw and at most as much packed), written in order.
+    const int batch = std::max(1, 256 / lines);
     const std::size_t slots = std::size_t(batch);
     std::vector<std::vector<unsigned char>> raw(slots), packed(slots);
     std::vector<std::size_t> size(slots);
