@@ -160,6 +160,7 @@ struct ExrScanlineReader::Impl {
 std::unique_ptr<ExrScanlineReader> ExrScanlineReader::open(const std::string& path, int width, int height,
                                                            const NativeLayout& layout) {
   if (!exr_scanline_io()) return nullptr;
+  t_message.clear();  // not an earlier file's
   auto m = std::make_unique<Impl>();
   m->path = path;
   m->width = width;
@@ -215,7 +216,7 @@ void ExrScanlineReader::read(int y0, int y1, unsigned char* dst) {
   std::mutex failure_lock;
   auto fail = [&](int y, const std::string& why) {
     const std::lock_guard<std::mutex> hold(failure_lock);
-    if (!failed.exchange(true)) failure = "rows from " + std::to_string(y) + ": " + why;
+    if (!failed.exchange(true)) failure = "rows from " + std::to_string(y) + ": " + (why.empty() ? "unreadable chunk" : why);
   };
   const std::size_t row_bytes = std::size_t(m.width) * m.stride;
   parallel_rows(y0 / m.lines, (y1 - 1) / m.lines + 1, 0, [&](int k) {
@@ -224,6 +225,7 @@ void ExrScanlineReader::read(int y0, int y1, unsigned char* dst) {
     const int rows = std::min(m.lines, m.dw.max.y + 1 - y);
     const std::size_t expect = std::size_t(rows) * m.line_bytes;
     exr_chunk_info_t ci;
+    t_message.clear();
     if (exr_read_scanline_chunk_info(m.c.ctxt, 0, y, &ci) != EXR_ERR_SUCCESS) return fail(y, t_message);
     if (ci.data_offset != m.table[std::size_t(k)] + 8)  // after the chunk's row and size fields
       return fail(y, "the chunk offset table is damaged (chunk " + std::to_string(k) + " at byte " +
@@ -270,6 +272,7 @@ int write_exr_scanlines(int fd, const std::string& path, int width, int height, 
   // OpenImageIO leaves OpenEXR 3.1's zip level (4) unless one is given.
   const int level = compression.find(':') == std::string::npos ? 4 : std::atoi(compression.c_str() + compression.find(':') + 1);
 
+  t_message.clear();
   Sink sink;
   sink.fd = fd;
   exr_context_initializer_t init = initializer(&sink);
