@@ -60,7 +60,8 @@ struct FileBands::Impl {
   int last_y0 = 0, last_y1 = 0, keep = 0;
   double read_ms = 0;
   // A scanline zip, zips or uncompressed file of half and float channels: read in its own
-  // types through io/exr_scanline_io.h (libdeflate), as read_frame reads it; else OpenImageIO.
+  // types through io/exr_scanline_io.h (libdeflate), as read_frame reads it; else OpenImageIO,
+  // as floats. `native` lays out the rows either gives.
   std::unique_ptr<ExrScanlineReader> scan;
   NativeLayout native;
 };
@@ -97,17 +98,13 @@ FileBands::FileBands(const std::string& path, const ReadOptions& options, const 
     m.sources.push_back(std::move(src));
     m.layout.passes.push_back(std::move(p));
   }
-  bool half_or_float = m.spec.tile_width == 0;
-  for (int c = 0; c < nch && half_or_float; ++c) {
-    const TypeDesc t = m.spec.channelformat(c);
-    half_or_float = t == TypeHalf || t == TypeFloat;
-    m.native.offset.push_back(m.native.stride);
-    m.native.is_half.push_back(t == TypeHalf);
-    m.native.stride += t.size();
-  }
-  if (half_or_float) {
-    m.native.names = names;
+  if (m.spec.tile_width == 0 && native_layout_of(m.spec, m.native))
     m.scan = ExrScanlineReader::open(path, m.spec.width, m.spec.height, m.native);
+  if (!m.scan) {  // OpenImageIO's reads, as floats
+    m.native = NativeLayout{};
+    m.native.names = names;
+    for (int c = 0; c < nch; ++c) m.native.offset.push_back(std::size_t(c) * sizeof(float)), m.native.is_half.push_back(0);
+    m.native.stride = std::size_t(nch) * sizeof(float);
   }
 }
 
@@ -147,51 +144,40 @@ Frame FileBands::rows(int y0, int y1) {
     }
     from = c1;
   }
-  // Scanline files in chunks of kChunkRows; tiled ones a row of tiles at a time (OpenImageIO
-  // reads tiles only on their grid), of which the rows wanted are copied.
-  // The scanline reader's windows start on its chunk grid (each zip block decoded once).
+  // Scanline files in chunks of kChunkRows, starting on the scanline reader's chunk grid (each
+  // zip block decoded once); tiled ones a row of tiles at a time (OpenImageIO reads tiles only on
+  // their grid), of which the rows wanted are copied.
   const int tile_h = m.spec.tile_width > 0 ? std::max(1, m.spec.tile_height) : 0;
   const int grid = tile_h > 0 ? tile_h : m.scan ? m.scan->chunk_rows() : 1;
   const int chunk_rows = tile_h > 0 ? tile_h : kChunkRows;
-  std::vector<float> chunk(m.scan ? 0 : std::size_t(w) * std::size_t(nch) * std::size_t(chunk_rows));
-  std::vector<unsigned char> native(m.scan ? std::size_t(w) * m.native.stride * std::size_t(chunk_rows) : 0);
+  std::vector<unsigned char> chunk(std::size_t(w) * m.native.stride * std::size_t(chunk_rows));
   for (int c0 = from; c0 < y1;) {
     const int t0 = c0 / grid * grid;  // the chunk's first row in the file
     const int t1 = std::min(m.spec.height, t0 + chunk_rows);
     const int c1 = std::min(y1, t1);
+    const unsigned char* rows = chunk.data();  // row c0
     if (m.scan) {
-      m.scan->read(c0, c1, native.data());
-      for (std::size_t k = 0; k < f.passes.size(); ++k) {
-        Image& im = f.passes[k].image;
-        const std::vector<int>& src = m.sources[k];
-        const std::size_t pc = std::size_t(im.channels());
-        parallel_rows(c0, c1, 0, [&](int y) {
-          const unsigned char* s = native.data() + std::size_t(y - c0) * std::size_t(w) * m.native.stride;
-          for (std::size_t c = 0; c < pc; ++c) {
-            const std::size_t ch = std::size_t(src[c]);
-            native_channel_to_float(s + m.native.offset[ch], m.native.stride, m.native.is_half[ch], std::size_t(w),
-                                    im.pixel(0, y - y0) + c, pc);
-          }
-        });
-      }
-      c0 = c1;
-      continue;
+      m.scan->read(c0, c1, chunk.data());
+    } else {
+      const bool ok = tile_h > 0 ? m.in->read_tiles(0, 0, m.spec.x, m.spec.x + w, m.spec.y + t0, m.spec.y + t1, m.spec.z,
+                                                     m.spec.z + 1, 0, nch, TypeDesc::FLOAT, chunk.data())
+                                 : m.in->read_scanlines(0, 0, m.spec.y + t0, m.spec.y + t1, 0, 0, nch, TypeDesc::FLOAT, chunk.data());
+      if (!ok)
+        throw Error(Errc::ReadFailed, "cannot read rows " + std::to_string(t0) + ".." + std::to_string(t1) + " of '" + m.path +
+                                          "': " + m.in->geterror());
+      rows += std::size_t(c0 - t0) * std::size_t(w) * m.native.stride;
     }
-    const bool ok = tile_h > 0 ? m.in->read_tiles(0, 0, m.spec.x, m.spec.x + w, m.spec.y + t0, m.spec.y + t1, m.spec.z,
-                                                   m.spec.z + 1, 0, nch, TypeDesc::FLOAT, chunk.data())
-                               : m.in->read_scanlines(0, 0, m.spec.y + t0, m.spec.y + t1, 0, 0, nch, TypeDesc::FLOAT, chunk.data());
-    if (!ok)
-      throw Error(Errc::ReadFailed, "cannot read rows " + std::to_string(t0) + ".." + std::to_string(t1) + " of '" + m.path +
-                                        "': " + m.in->geterror());
     for (std::size_t k = 0; k < f.passes.size(); ++k) {
       Image& im = f.passes[k].image;
       const std::vector<int>& src = m.sources[k];
-      const int pc = im.channels();
+      const std::size_t pc = std::size_t(im.channels());
       parallel_rows(c0, c1, 0, [&](int y) {
-        const float* s = chunk.data() + std::size_t(y - t0) * std::size_t(w) * std::size_t(nch);
-        float* d = im.pixel(0, y - y0);
-        for (int x = 0; x < w; ++x)
-          for (int c = 0; c < pc; ++c) d[std::size_t(x) * pc + c] = s[std::size_t(x) * nch + src[std::size_t(c)]];
+        const unsigned char* s = rows + std::size_t(y - c0) * std::size_t(w) * m.native.stride;
+        for (std::size_t c = 0; c < pc; ++c) {
+          const std::size_t ch = std::size_t(src[c]);
+          native_channel_to_float(s + m.native.offset[ch], m.native.stride, m.native.is_half[ch], std::size_t(w),
+                                  im.pixel(0, y - y0) + c, pc);
+        }
       });
     }
     c0 = c1;

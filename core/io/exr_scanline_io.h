@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "image/pass.h"
+#include "io/native_pixels.h"
 
 namespace mcr {
 
@@ -18,14 +19,6 @@ namespace mcr {
 void set_exr_scanline_io(bool on);
 bool exr_scanline_io();
 
-// Where each channel goes in an interleaved pixel buffer of `stride` bytes per pixel: the
-// channel named names[c] at byte offset[c], half when is_half[c] else float.
-struct NativeLayout {
-  std::vector<std::string> names;
-  std::vector<std::size_t> offset;
-  std::vector<char> is_half;
-  std::size_t stride = 0;
-};
 
 // A file of those opened to read rows, as often as needed (a frame read in bands).
 class ExrScanlineReader {

@@ -38,8 +38,7 @@ struct RawImage {
   PixelWindow window;
   std::vector<std::string> names;
   std::vector<float> pixels;
-  // The native form, used instead of pixels when not empty: packed pixels of `stride` bytes,
-  // channel c at byte offset[c], half when is_half[c], else float.
+  // The native form, used instead of pixels when not empty: packed pixels laid out as `layout`.
   // Not zeroed when sized (every byte is decoded into it): a 50 MB frame's memset and page
   // faults on one thread would be a tenth of the read.
   struct NoInit : std::allocator<unsigned char> {
@@ -48,21 +47,11 @@ struct RawImage {
     using std::allocator<unsigned char>::allocator;
   };
   std::vector<unsigned char, NoInit> native;
-  std::vector<std::size_t> offset;
-  std::vector<char> is_half;
-  std::size_t stride = 0;
+  NativeLayout layout;
   std::shared_ptr<DeepSamples> deep;
   std::shared_ptr<const LightField> lightfield;
   bool independent_samples = false;  // deep, no alpha, not a light field: the per-sample convention
 };
-
-bool half_or_float(const ImageSpec& spec) {
-  for (int c = 0; c < spec.nchannels; ++c) {
-    const TypeDesc t = spec.channelformat(c);
-    if (t != TypeHalf && t != TypeFloat) return false;
-  }
-  return true;
-}
 
 std::shared_ptr<DeepSamples> copy_deep(const DeepData& dd, const ImageSpec& spec) {
   auto deep = std::make_shared<DeepSamples>();
@@ -166,21 +155,15 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
       raw.names.push_back(taken ? part_name + "." + n : n);
     }
     bool only_part = false;
-    if (part == 0 && half_or_float(spec)) {
+    if (part == 0 && native_layout_of(spec, raw.layout)) {
       only_part = !in.seek_subimage(1, 0);
       if (only_part) (void)in.geterror();  // the probe's "no such part" is not this read's error
       if (!in.seek_subimage(0, 0))
         throw Error(Errc::ReadFailed, "cannot read '" + path + "' part 0 again: " + in.geterror());
     }
     if (only_part) {
-      for (int c = 0; c < spec.nchannels; ++c) {
-        raw.offset.push_back(raw.stride);
-        raw.is_half.push_back(spec.channelformat(c) == TypeHalf);
-        raw.stride += spec.channelformat(c).size();
-      }
-      raw.native.resize(std::size_t(spec.width) * spec.height * raw.stride);
-      const NativeLayout layout{raw.names, raw.offset, raw.is_half, raw.stride};
-      if (read_exr_scanlines(path, spec.width, spec.height, layout, raw.native.data())) return;
+      raw.native.resize(std::size_t(spec.width) * spec.height * raw.layout.stride);
+      if (read_exr_scanlines(path, spec.width, spec.height, raw.layout, raw.native.data())) return;
       if (!in.read_image(0, 0, 0, spec.nchannels, TypeUnknown, raw.native.data()))
         throw Error(Errc::ReadFailed, "cannot read pixels of '" + path + "' " + part_label(spec, part) +
                                           " (truncated or corrupt?): " + in.geterror());
@@ -275,8 +258,8 @@ void fill_passes(const RawImage& raw, const std::vector<Pass*>& passes, const st
           for (std::size_t x = 0; x < w; ++x) out[x * nc + c] = in[x * nin];
           continue;
         }
-        native_channel_to_float(raw.native.data() + row * raw.stride + raw.offset[ch], raw.stride, raw.is_half[ch], w,
-                                out + c, nc);
+        const NativeLayout& l = raw.layout;
+        native_channel_to_float(raw.native.data() + row * l.stride + l.offset[ch], l.stride, l.is_half[ch], w, out + c, nc);
       }
     }
   });

@@ -151,10 +151,9 @@ void write_result(const std::string& path, const Image& rgb, const Frame& input,
     for (std::size_t i = 0; i < n; ++i) pixels[i * nc + c] = d[i * sc + s.channel];
   }
   if (exr_scanline_compression(options.compression)) {
-    std::vector<std::pair<std::string, std::string>> attributes = options.attributes;
     write_fd_atomic(path, [&](int fd) {
       return write_exr_scanlines(fd, path, input.width, input.height, input.window, names, pixels.data(),
-                                 options.compression, attributes);
+                                 options.compression, options.attributes);
     });
     return;
   }
