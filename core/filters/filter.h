@@ -72,6 +72,12 @@ class Filter {
   // Drops temporal history (new shot, frames out of order).
   virtual void reset() {}
 
+  // With light passes (pipeline/components.h): whether it divides each component by its
+  // colour pass (the albedo it is given) itself and multiplies back before work that must
+  // see the shown colour (bmfr's TAA), so that it takes the component remodulated. Else it
+  // takes the light alone and the recombination multiplies its result.
+  virtual bool demodulates_itself() const { return false; }
+
   // What the current settings read: the filter's own needs plus its preparation steps'.
   PassNeeds needs() const;
   // Passes in needs().required that the frame lacks.

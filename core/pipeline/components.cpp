@@ -124,7 +124,8 @@ void check_light_passes(const Frame& frame) {
                   "view layer, or use components=beauty)");
 }
 
-Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads, LightPart part) {
+Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads, LightPart part,
+                      bool remodulated) {
   Frame out = frame.header(frame.width, frame.height);
   out.window = frame.window;
   out.deep = frame.deep;
@@ -164,12 +165,16 @@ Frame component_frame(const Frame& frame, const LightComponent& component, int n
   const Image& b = indirect.image;
   const int ca = a.channels(), cb = b.channels();
   const bool with_a = part != LightPart::Indirect, with_b = part != LightPart::Direct;
+  const Image& col = frame.image(component.colour);
+  const int cc = col.channels();
   parallel_rows(0, frame.height, nthreads, [&](int y) {
     for (int x = 0; x < frame.width; ++x) {
       const float* pa = a.pixel(x, y);
       const float* pb = b.pixel(x, y);
       float* o = light.image.pixel(x, y);
       for (int c = 0; c < 3; ++c) o[c] = (with_a ? pa[c < ca ? c : 0] : 0.0f) + (with_b ? pb[c < cb ? c : 0] : 0.0f);
+      if (remodulated)
+        for (int c = 0; c < 3; ++c) o[c] = clamped(o[c] * finite_or_zero(col.at(x, y, c < cc ? c : 0)));
     }
   });
   out.passes.push_back(std::move(light));
@@ -187,7 +192,7 @@ void add_light(Image& sum, const Image& part, int nthreads) {
   });
 }
 
-Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int nthreads) {
+Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int nthreads, bool remodulated) {
   const auto& comps = light_components();
   if (filtered.size() != comps.size())
     throw Error(Errc::Internal, "recombine: " + std::to_string(filtered.size()) + " filtered components");
@@ -211,7 +216,8 @@ Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int
         const float* light = filtered[k].pixel(x, y);
         const float* col = colour[k]->pixel(x, y);
         const int cc = colour[k]->channels();
-        for (int c = 0; c < 3; ++c) add(k, clamped(light[c] * finite_or_zero(col[c < cc ? c : 0])), c);
+        for (int c = 0; c < 3; ++c)
+          add(k, clamped(remodulated ? light[c] : light[c] * finite_or_zero(col[c < cc ? c : 0])), c);
       }
       for (int c = 0; c < 3; ++c) add(comps.size(), finite_or_zero(emit.at(x, y, c < emit.channels() ? c : 0)), c);
       for (int c = 0; c < 3; ++c) add(comps.size() + 1, finite_or_zero(env.at(x, y, c < env.channels() ? c : 0)), c);

@@ -82,7 +82,7 @@ void check_light_passes(const Frame& frame);
 // the colour pass is smooth and tells metal from dielectric. Not the variance pass: it
 // measures the beauty's noise, not this light's.
 Frame component_frame(const Frame& frame, const LightComponent& component, int nthreads,
-                      LightPart part = LightPart::Both);
+                      LightPart part = LightPart::Both, bool remodulated = false);
 
 // sum += part, clamped to the float range (a component's filtered direct and indirect light).
 void add_light(Image& sum, const Image& part, int nthreads);
@@ -97,10 +97,11 @@ struct Recombined {
   Image beauty;                        // their float sum, in that order
 };
 
-// filtered[i] (the light of light_components()[i], RGB) times its colour pass, then
+// filtered[i] (the light of light_components()[i], RGB) times its colour pass (as it is
+// when `remodulated`: the filter multiplied it back itself), then
 // emission and environment as they are; non-finite colour, emission or environment
 // values count as 0 (an infinite one as +-FLT_MAX), products and sums are clamped to the
 // float range: nothing non-finite leaves.
-Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int nthreads);
+Recombined recombine(const Frame& frame, const std::vector<Image>& filtered, int nthreads, bool remodulated = false);
 
 }  // namespace mcr

@@ -37,13 +37,13 @@ Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate) 
   const bool split = uses_light_passes(filter->params());
   if (split) {
     // The light passes are already divided by their colour pass: a second division by the
-    // albedo would remodulate the light with the wrong colour.
-    for (const char* name : {"demodulate", "albedo_demodulation"}) {
-      if (!filter->params().has(name)) continue;
-      if (filter->params().was_set(name) && filter->params().get_bool(name))
-        setup_notes_.push_back(std::string(name) + "=true has no effect with components=light_passes (each light pass "
-                                                   "is already divided by its colour pass)");
-      filter->set(name, false);
+    // albedo would remodulate the light with the wrong colour. A filter that divides by it
+    // itself (demodulates_itself) is given the light times its colour pass instead.
+    if (filter->params().has("demodulate")) {
+      if (filter->params().was_set("demodulate") && filter->params().get_bool("demodulate"))
+        setup_notes_.push_back("demodulate=true has no effect with components=light_passes (each light pass is already "
+                               "divided by its colour pass)");
+      filter->set("demodulate", false);
     }
     filter->commit();
   }
@@ -128,9 +128,10 @@ Image Reconstruction::run_components(const Frame& frame, const ExecOptions& opti
   const auto& comps = light_components();
   const auto& parts = light_stages();
   std::vector<Image> filtered(comps.size());
+  const bool remodulated = filter().demodulates_itself();
   for (std::size_t i = 0; i < parts.size(); ++i) {
     const LightStage& s = parts[i];
-    Frame part = component_frame(frame, comps[s.component], options.nthreads, s.part);
+    Frame part = component_frame(frame, comps[s.component], options.nthreads, s.part, remodulated);
     const std::size_t before = notes_.size();
     Image light = run_stage(*stages_[i], part, options);
     Image& sum = filtered[s.component];
@@ -142,10 +143,12 @@ Image Reconstruction::run_components(const Frame& frame, const ExecOptions& opti
     for (std::size_t k = before; k < notes_.size(); ++k) notes_[k] = name + ": " + notes_[k];
     for (const std::string& m : stages_[i]->filter->notes()) notes_.push_back(name + ": " + m);
   }
-  Recombined r = recombine(frame, filtered, options.nthreads);
-  notes_.push_back("components=light_passes: diffuse light (direct + indirect), glossy and transmission light (direct "
-                   "and indirect apart, then added) filtered one by one and multiplied by their colour pass; emission "
-                   "and environment passed through");
+  Recombined r = recombine(frame, filtered, options.nthreads, remodulated);
+  notes_.push_back(std::string("components=light_passes: diffuse light (direct + indirect), glossy and transmission "
+                               "light (direct and indirect apart, then added) filtered one by one ") +
+                   (remodulated ? "times their colour pass, which the filter divides by and multiplies back"
+                                : "and multiplied by their colour pass") +
+                   "; emission and environment passed through");
   if (components) *components = std::move(r.layers);
   return std::move(r.beauty);
 }

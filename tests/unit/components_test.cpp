@@ -70,15 +70,19 @@ Frame light_frame(int w, int h, unsigned seed) {
 }
 
 // Component k of `f` as an ordinary frame, built here: colour = direct + indirect (only one
-// of them for `part`), albedo = its colour pass, the other features.
-Frame alone(const Frame& f, int k, LightPart part = LightPart::Both) {
+// of them for `part`; times the colour pass when `remodulated`), albedo = its colour pass,
+// the other features.
+Frame alone(const Frame& f, int k, LightPart part = LightPart::Both, bool remodulated = false) {
   Frame g;
   g.width = f.width;
   g.height = f.height;
   g.path = f.path;
   const Image& d = f.image(kParts[k].direct);
   const Image& i = f.image(kParts[k].indirect);
-  add_pass(g, Role::Colour, part == LightPart::Direct ? d : part == LightPart::Indirect ? i : sum_of(d, i));
+  Image light = part == LightPart::Direct ? d : part == LightPart::Indirect ? i : sum_of(d, i);
+  if (remodulated)
+    for (std::size_t j = 0; j < light.storage().size(); ++j) light.storage()[j] *= f.image(kParts[k].colour).storage()[j];
+  add_pass(g, Role::Colour, light);
   add_pass(g, Role::Albedo, f.image(kParts[k].colour));
   for (Role r : {Role::Normal, Role::Position, Role::Motion}) add_pass(g, r, f.image(r));
   return g;
@@ -132,8 +136,12 @@ TEST(Components, DemodulationIsTurnedOffAndSaidSo) {
   bool noted = false;
   for (const std::string& n : on->notes()) noted = noted || n.find("demodulate=true has no effect") != std::string::npos;
   EXPECT_TRUE(noted);
+  // bmfr divides by its albedo itself (and multiplies back before its TAA): it keeps that
+  // and is given each component times its colour pass (TemporalHistoriesArePerComponent).
   auto bmfr = reconstruction("bmfr", {}, true);
-  EXPECT_FALSE(bmfr->filter().params().get_bool("albedo_demodulation"));
+  EXPECT_TRUE(bmfr->filter().params().get_bool("albedo_demodulation"));
+  EXPECT_TRUE(bmfr->filter().demodulates_itself());
+  EXPECT_FALSE(reconstruction("bmfr", {{"albedo_demodulation", "false"}}, true)->filter().demodulates_itself());
   EXPECT_NE(bmfr->parameters_text().find("components=light_passes"), std::string::npos);
 }
 
@@ -154,38 +162,42 @@ TEST(Components, EveryMissingLightPassIsNamedWithTheFile) {
 
 // One history per stage: two frames through the split equal each stage's own filter run
 // alone on the same two frames (diffuse: direct + indirect; glossy and transmission: the
-// direct and the indirect light each alone, added after filtering).
+// direct and the indirect light each alone, added after filtering). bmfr, which divides by
+// its albedo itself, is given each light times its colour pass and its result is the layer;
+// any other filter (and bmfr with albedo_demodulation=false) the light, times the colour after.
 TEST(Components, TemporalHistoriesArePerComponent) {
   const Frame f1 = light_frame(24, 20, 11), f2 = light_frame(24, 20, 12);
   struct Case {
     std::string filter;
     std::vector<std::pair<std::string, std::string>> params;
-    bool accumulate;
+    bool accumulate, remodulated;
   };
-  for (const Case& c : {Case{"bmfr", {{"block_size", "8"}, {"features", "with_albedo"}}, false}, Case{"box", {{"radius", "0"}, {"step_back", "false"}}, true}}) {
-    SCOPED_TRACE(c.filter);
+  const std::pair<std::string, std::string> bs{"block_size", "8"}, fe{"features", "with_albedo"};
+  for (const Case& c : {Case{"bmfr", {bs, fe}, false, true}, Case{"bmfr", {bs, fe, {"albedo_demodulation", "false"}}, false, false},
+                        Case{"box", {{"radius", "0"}, {"step_back", "false"}}, true, false}}) {
+    SCOPED_TRACE(c.filter + (c.remodulated ? " remodulated" : ""));
     auto split = reconstruction(c.filter, c.params, true, c.accumulate);
     // [k][0]: diffuse direct + indirect, else direct; [k][1]: indirect.
     std::unique_ptr<Reconstruction> single[3][2];
-    auto single_params = c.params;
-    if (c.filter == "bmfr") single_params.push_back({"albedo_demodulation", "false"});
     for (auto& k : single)
-      for (auto& p : k) p = reconstruction(c.filter, single_params, false, c.accumulate);
+      for (auto& p : k) p = reconstruction(c.filter, c.params, false, c.accumulate);
     std::vector<ComponentImage> layers;
     for (const Frame* f : {&f1, &f2}) {
       split->run(*f, {}, &layers);
       for (int k = 0; k < 3; ++k) {
         Image light;
         if (k == 0) {
-          light = single[k][0]->run(alone(*f, k));
+          light = single[k][0]->run(alone(*f, k, LightPart::Both, c.remodulated));
         } else {
-          light = single[k][0]->run(alone(*f, k, LightPart::Direct));
-          const Image indirect = single[k][1]->run(alone(*f, k, LightPart::Indirect));
+          light = single[k][0]->run(alone(*f, k, LightPart::Direct, c.remodulated));
+          const Image indirect = single[k][1]->run(alone(*f, k, LightPart::Indirect, c.remodulated));
           for (std::size_t j = 0; j < light.storage().size(); ++j) light.storage()[j] += indirect.storage()[j];
         }
         const Image& col = f->image(kParts[k].colour);
         for (std::size_t j = 0; j < col.storage().size(); ++j)
-          ASSERT_EQ(layers[std::size_t(k)].rgb.storage()[j], light.storage()[j] * col.storage()[j]) << k << " " << j;
+          ASSERT_EQ(layers[std::size_t(k)].rgb.storage()[j],
+                    c.remodulated ? light.storage()[j] : light.storage()[j] * col.storage()[j])
+              << k << " " << j;
       }
     }
   }

@@ -50,6 +50,9 @@ class BmfrFilter : public Filter {
   BmfrFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
   void reset() override;
+  // Its TAA runs after the remodulation: with light passes it must clip and blend the
+  // component as shown (the colour pass's 1-spp edges included), as it does the beauty.
+  bool demodulates_itself() const override { return params().get_bool("albedo_demodulation"); }
 
   // Milliseconds of the stages of the last execute(): demodulation + phase I, phase II
   // (fit), phase III (second accumulation + remodulation), TAA.
