@@ -266,13 +266,14 @@ void speed(int threads, int repeat, int nframes) {
   std::printf("\nspeed: %dx%d (anim 1 spp upscaled x%d), %zu frames, %d threads, best of %d passes; load before: %s\n",
               frames[0].width, frames[0].height, factor, frames.size(), threads, repeat, loadavg().c_str());
   std::printf("  wall ms per frame (best pass), then process CPU ms (all threads) per stage and per frame\n");
-  std::printf("  %-28s %7s %7s %7s %7s %7s | %6s %6s %6s %6s %9s\n", "config", "phaseI", "fit", "phIII", "taa", "total", "cI",
-              "cfit", "cIII", "ctaa", "cpu/frame");
+  std::printf("  %-28s %7s %7s %7s %7s %7s %7s | %6s %6s %6s %6s %6s %9s\n", "config", "phaseI", "fit", "phIII",
+              "detail", "taa", "total", "cI", "cfit", "cIII", "cdet", "ctaa", "cpu/frame");
   struct Config {
     std::string label;
     std::vector<std::pair<std::string, std::string>> params;
   };
   const std::vector<Config> configs = {{"default (auto = 32 at 720p)", {}},
+                                       {"residual_k=0 (no detail)", {{"residual_k", "0"}}},
                                        {"block_size=16", {{"block_size", "16"}}},
                                        {"block_size=64", {{"block_size", "64"}}},
                                        {"features=first_order", {{"features", "first_order"}}},
@@ -285,10 +286,13 @@ void speed(int threads, int repeat, int nframes) {
     for (const auto& kv : c.params) f->set_text(kv.first, kv.second);
     f->commit();
     auto* b = dynamic_cast<BmfrFilter*>(f.get());
-    double best[5] = {1e30, 1e30, 1e30, 1e30, 1e30}, best_cpu = 1e30, best_scpu[4] = {1e30, 1e30, 1e30, 1e30};
+    constexpr int S = BmfrFilter::kStages;  // the stages, then the whole frame
+    double best[S + 1], best_cpu = 1e30, best_scpu[S];
+    std::fill(best, best + S + 1, 1e30);
+    std::fill(best_scpu, best_scpu + S, 1e30);
     for (int r = 0; r < repeat; ++r) {
       f->reset();
-      double sum[5] = {0, 0, 0, 0, 0}, scpu[4] = {0, 0, 0, 0};
+      double sum[S + 1] = {}, scpu[S] = {};
       int counted = 0;
       double cpu = 0;
       for (std::size_t i = 0; i < frames.size(); ++i) {
@@ -298,17 +302,18 @@ void speed(int threads, int repeat, int nframes) {
         const double total = ms_since(t0);
         if (i == 0) continue;
         cpu += cpu_ms() - c0;
-        for (int s = 0; s < 4; ++s) sum[s] += b->stage_ms()[std::size_t(s)];
-        for (int s = 0; s < 4; ++s) scpu[s] += b->stage_cpu_ms()[std::size_t(s)];
-        sum[4] += total;
+        for (int s = 0; s < S; ++s) sum[s] += b->stage_ms()[std::size_t(s)];
+        for (int s = 0; s < S; ++s) scpu[s] += b->stage_cpu_ms()[std::size_t(s)];
+        sum[S] += total;
         ++counted;
       }
-      for (int s = 0; s < 5; ++s) best[s] = std::min(best[s], sum[s] / std::max(1, counted));
+      for (int s = 0; s <= S; ++s) best[s] = std::min(best[s], sum[s] / std::max(1, counted));
       best_cpu = std::min(best_cpu, cpu / std::max(1, counted));
-      for (int s = 0; s < 4; ++s) best_scpu[s] = std::min(best_scpu[s], scpu[s] / std::max(1, counted));
+      for (int s = 0; s < S; ++s) best_scpu[s] = std::min(best_scpu[s], scpu[s] / std::max(1, counted));
     }
-    std::printf("  %-28s %7.2f %7.2f %7.2f %7.2f %7.2f | %6.2f %6.2f %6.2f %6.2f %9.2f\n", c.label.c_str(), best[0], best[1],
-                best[2], best[3], best[4], best_scpu[0], best_scpu[1], best_scpu[2], best_scpu[3], best_cpu);
+    std::printf("  %-28s %7.2f %7.2f %7.2f %7.2f %7.2f %7.2f | %6.2f %6.2f %6.2f %6.2f %6.2f %9.2f\n", c.label.c_str(),
+                best[0], best[1], best[2], best[3], best[4], best[5], best_scpu[0], best_scpu[1], best_scpu[2], best_scpu[3],
+                best_scpu[4], best_cpu);
   }
   // I/O floor: read the multi-pass frame, write the RGBA result.
   const std::string dir = (std::filesystem::temp_directory_path() / "mcrecon_bench_bmfr").string();

@@ -126,10 +126,10 @@ TEST(Bmfr, FirstOrderFitIsTheBlockwiseLeastSquaresFit) {
   // First order cannot represent w_z^2: on the first frame (no history to accumulate), with no
   // regularisation noise, grid offset or TAA, the output is the per-block least-squares fit.
   const Scene s = linear_scene(70, 45);
-  // step_back off: the fit itself is under test (on a still the step back would blend it
-  // toward the input).
+  // step_back and the detail stage off: the fit itself is under test (on a still the step
+  // back would blend it toward the input; the detail stage adds back what it misses).
   auto f = make_bmfr({{"features", std::string("first_order")}, {"epsilon", 0.0}, {"block_size", std::int64_t(16)},
-                      {"offsets", false}, {"taa", false}, {"step_back", false}});
+                      {"offsets", false}, {"taa", false}, {"step_back", false}, {"residual_k", 0.0}});
   const Image want = blockwise_first_order_fit(s, 16);
   EXPECT_LT(max_rel_error(f->execute(frame_of(s)), want), 1e-5);
   EXPECT_GT(max_rel_error(want, s.colour), 1e-3);  // and the fit is not the input

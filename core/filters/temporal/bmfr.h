@@ -55,8 +55,9 @@ class BmfrFilter : public Filter {
   bool demodulates_itself() const override { return params().get_bool("albedo_demodulation"); }
 
   // Milliseconds of the stages of the last execute(): demodulation + phase I, phase II
-  // (fit), phase III (second accumulation + remodulation), TAA.
-  enum Stage { kAccumulate, kFit, kPost, kTaa, kStages };
+  // (fit), phase III (second accumulation + remodulation), the detail added back
+  // (bmfr_residual.h), TAA.
+  enum Stage { kAccumulate, kFit, kPost, kDetail, kTaa, kStages };
   const std::array<double, kStages>& stage_ms() const { return stage_ms_; }
   // The same stages in process CPU time (all threads), ms: robust on a loaded machine.
   const std::array<double, kStages>& stage_cpu_ms() const { return stage_cpu_ms_; }
@@ -103,6 +104,7 @@ class BmfrFilter : public Filter {
   std::int64_t frame_index_ = 0;
   bool last_cut_ = false;
   bool had_history_ = false;  // the last run() blended a usable history
+  std::vector<float> residual_scratch_;  // the detail stage's window sums (bmfr_residual.h)
   std::array<double, kStages> stage_ms_{};
   std::array<double, kStages> stage_cpu_ms_{};
 };
