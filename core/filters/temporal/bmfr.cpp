@@ -7,7 +7,7 @@
 #include <limits>
 #include <ctime>
 
-#include "filters/temporal/bmfr_residual.h"
+#include "kernels/residual_shrink.h"
 #include "prepare/demodulation.h"
 #include "prepare/history_guards.h"
 #include "prepare/surface_classes.h"
@@ -97,7 +97,7 @@ const FilterInfo& BmfrFilter::static_info() {
                          "is added back before TAA with the James-Stein weight 1 - residual_k x its noise / its square "
                          "(a hard shadow on a flat wall, which no feature explains, comes back; noise about a right fit "
                          "does not; 3 with residual_radius 2: chosen on the metal and anim samples); 0 = off "
-                         "(bmfr_residual.h)"),
+                         "(kernels/residual_shrink.h)"),
         ParamSpec::Int("residual_radius", 2, 1, 4, "detail: half width of the residual's window"),
         ParamSpec::Bool("fit_clamp", true,
                         "clamp the fitted illumination to [min(0, block min), max(0, block max)] of the block's "
@@ -371,7 +371,8 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     ResidualSettings rs;
     rs.k = params_.get_float("residual_k");
     rs.radius = int(params_.get_int("residual_radius"));
-    const std::size_t taken = add_back_residual(rs, acc1, demod ? &albedo_ : nullptr, res_.data(), residual_scratch_, nthreads);
+    const std::size_t taken =
+        add_back_residual(rs, acc1, demod ? &albedo_ : nullptr, {res_.data(), 1, n}, residual_scratch_, nthreads);
     note("bmfr: detail the fit missed added back at " + std::to_string(taken) + " pixels (over half their window's "
          "residual against the accumulated frames)");
     if (!use_taa) write_planar_roi(res_.data(), n, w, roi, out, nthreads);

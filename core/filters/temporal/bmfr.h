@@ -56,7 +56,7 @@ class BmfrFilter : public Filter {
 
   // Milliseconds of the stages of the last execute(): demodulation + phase I, phase II
   // (fit), phase III (second accumulation + remodulation), the detail added back
-  // (bmfr_residual.h), TAA.
+  // (kernels/residual_shrink.h), TAA.
   enum Stage { kAccumulate, kFit, kPost, kDetail, kTaa, kStages };
   const std::array<double, kStages>& stage_ms() const { return stage_ms_; }
   // The same stages in process CPU time (all threads), ms: robust on a loaded machine.
@@ -104,7 +104,7 @@ class BmfrFilter : public Filter {
   std::int64_t frame_index_ = 0;
   bool last_cut_ = false;
   bool had_history_ = false;  // the last run() blended a usable history
-  std::vector<float> residual_scratch_;  // the detail stage's window sums (bmfr_residual.h)
+  std::vector<float> residual_scratch_;  // the detail stage's window sums (kernels/residual_shrink.h)
   std::array<double, kStages> stage_ms_{};
   std::array<double, kStages> stage_cpu_ms_{};
 };

@@ -1,4 +1,4 @@
-#include "filters/temporal/bmfr_residual.h"
+#include "kernels/residual_shrink.h"
 
 #include <algorithm>
 #include <cmath>
@@ -15,12 +15,13 @@ constexpr int kPlanes = 5;  // finite count, residual R, G, B, sum over R, G, B 
 
 }  // namespace
 
-std::size_t add_back_residual(const ResidualSettings& s, const Image& accumulated, const Image* albedo, float* result,
+std::size_t add_back_residual(const ResidualSettings& s, const Image& unbiased, const Image* albedo, RgbLayout result,
                               std::vector<float>& scratch, int nthreads) {
-  const int w = accumulated.width(), h = accumulated.height();
-  const std::size_t n = accumulated.pixel_count();
+  const int w = unbiased.width(), h = unbiased.height();
+  const std::size_t n = unbiased.pixel_count();
   if (n == 0) return 0;
-  float* plane[3] = {result, result + n, result + 2 * n};
+  const std::size_t ps = result.pixel_stride, cs = result.channel_stride;
+  auto at = [&](std::size_t i, int c) -> float& { return result.data[i * ps + std::size_t(c) * cs]; };
   const int R = s.radius;
   // Row sums over each pixel's window columns (clipped to the frame), made from the
   // residual of that row on the fly: kPlanes planes of w x h (plane-major, so that the
@@ -35,10 +36,10 @@ std::size_t add_back_residual(const ResidualSettings& s, const Image& accumulate
     for (int k = 0; k < kPlanes; ++k) r[k] = row.data() + std::size_t(k) * std::size_t(w);
     const std::size_t rb = std::size_t(y) * std::size_t(w);
     for (int x = 0; x < w; ++x) {
-      const float* a = accumulated.pixel(x, y);
+      const float* a = unbiased.pixel(x, y);
       const float* al = albedo ? albedo->pixel(x, y) : nullptr;
       float d[3];
-      for (int c = 0; c < 3; ++c) d[c] = a[c] * (al ? al[c] : 1.0f) - plane[c][rb + std::size_t(x)];
+      for (int c = 0; c < 3; ++c) d[c] = a[c] * (al ? al[c] : 1.0f) - at(rb + std::size_t(x), c);
       if (!(std::isfinite(d[0]) && std::isfinite(d[1]) && std::isfinite(d[2]))) continue;  // takes no part
       r[0][x] = 1.0f;
       r[1][x] = d[0];
@@ -81,7 +82,10 @@ std::size_t add_back_residual(const ResidualSettings& s, const Image& accumulate
       const double wt = std::min(1.0 - 3.0 * s.k * spread / (st * st * cnt), 1.0);
       const double m[3] = {s1 / cnt, s2 / cnt, s3 / cnt};
       constexpr double M = std::numeric_limits<float>::max();
-      for (int c = 0; c < 3; ++c) plane[c][rb + std::size_t(x)] = float(std::clamp(double(plane[c][rb + std::size_t(x)]) + wt * m[c], -M, M));
+      for (int c = 0; c < 3; ++c) {
+        float& o = at(rb + std::size_t(x), c);
+        o = float(std::clamp(double(o) + wt * m[c], -M, M));
+      }
       taken[std::size_t(y)] += wt > 0.5;
     }
   });

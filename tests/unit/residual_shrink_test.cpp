@@ -1,8 +1,8 @@
-// bmfr's detail stage (filters/temporal/bmfr_residual.h): the window's mean residual added
-// back with the James-Stein weight. Oracles: closed forms for a step in the residual (the
+// The residual shrink (kernels/residual_shrink.h; bmfr's detail stage): the window's mean
+// residual added back with the James-Stein weight. Oracles: closed forms for a step in the residual (the
 // window's mean and variance of a two-valued residual written out), the expected size of the
 // shrunk mean of pure noise, and a hard shadow on a flat wall through the whole filter.
-#include "filters/temporal/bmfr_residual.h"
+#include "kernels/residual_shrink.h"
 
 #include <gtest/gtest.h>
 
@@ -69,31 +69,40 @@ void expect_step_oracle(const Step& s, const std::vector<float>& before, const R
       }
 }
 
-TEST(BmfrResidual, AStepInTheResidualComesBackAsItsShrunkWindowMean) {
+TEST(ResidualShrink, AStepInTheResidualComesBackAsItsShrunkWindowMean) {
   for (int radius : {1, 2}) {
     SCOPED_TRACE(radius);
     Step s = step(1.0f);
     const std::vector<float> before = s.result;
     ResidualSettings rs;
     rs.radius = radius;
-    add_back_residual(rs, s.accumulated, nullptr, s.result.data(), scratch, 1);
+    add_back_residual(rs, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, scratch, 1);
     expect_step_oracle(s, before, rs);
     // Deep inside the step the whole residual comes back; past the window, nothing.
     EXPECT_NEAR(s.result[0] - before[0], kA, 1e-6);
     EXPECT_EQ(s.result[kW - 1], before[kW - 1]);
+    // The same result held interleaved (as the light-field filters hold theirs).
+    const std::size_t n = std::size_t(kW) * kH;
+    std::vector<float> inter(n * 3);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c = 0; c < 3; ++c) inter[i * 3 + c] = before[c * n + i];
+    add_back_residual(rs, s.accumulated, nullptr, {inter.data(), 3, 1}, scratch, 2);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t c = 0; c < 3; ++c) ASSERT_EQ(inter[i * 3 + c], s.result[c * n + i]) << i << " c" << c;
   }
 }
 
-TEST(BmfrResidual, WithAnAlbedoTheResidualIsOfTheRemodulatedAccumulation) {
+TEST(ResidualShrink, WithAnAlbedoTheResidualIsOfTheRemodulatedAccumulation) {
   Step s = step(2.5f);
   const std::vector<float> before = s.result;
   ResidualSettings rs;
-  const std::size_t taken = add_back_residual(rs, s.accumulated, &s.albedo, s.result.data(), scratch, 2);
+  const std::size_t taken =
+      add_back_residual(rs, s.accumulated, &s.albedo, {s.result.data(), 1, std::size_t(kW) * kH}, scratch, 2);
   expect_step_oracle(s, before, rs);
   EXPECT_GT(taken, std::size_t(kH * (kEdge - 2)));
 }
 
-TEST(BmfrResidual, NoiseAboutARightFitAddsLittle) {
+TEST(ResidualShrink, NoiseAboutARightFitAddsLittle) {
   // Pure noise (sigma 1, channels independent) about the result: the window mean of 25 has
   // deviation 0.2, added whole (k = 0) its RMS is 0.2. Shrunk (k = 3) a pixel takes some
   // only where 25 m_l^2 > 3 v_l: m_l (the mean over R, G, B) has variance 1/75, so where a
@@ -108,7 +117,7 @@ TEST(BmfrResidual, NoiseAboutARightFitAddsLittle) {
     std::vector<float> result(n * 3, 0.0f);
     ResidualSettings rs;
     rs.k = k;
-    add_back_residual(rs, acc, nullptr, result.data(), scratch, 2);
+    add_back_residual(rs, acc, nullptr, {result.data(), 1, n}, scratch, 2);
     double s2 = 0;
     for (float v : result) s2 += double(v) * v;
     return std::sqrt(s2 / double(result.size()));
@@ -117,12 +126,12 @@ TEST(BmfrResidual, NoiseAboutARightFitAddsLittle) {
   EXPECT_LT(rms_of_addition(3.0), 0.01);
 }
 
-TEST(BmfrResidual, NonFiniteResidualsTakeNoPart) {
+TEST(ResidualShrink, NonFiniteResidualsTakeNoPart) {
   Step s = step(1.0f);
   const std::vector<float> before = s.result;
   s.accumulated.at(3, 4, 1) = std::numeric_limits<float>::quiet_NaN();
   s.accumulated.at(5, 2, 0) = std::numeric_limits<float>::infinity();
-  add_back_residual({}, s.accumulated, nullptr, s.result.data(), scratch, 1);
+  add_back_residual({}, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, scratch, 1);
   const std::size_t n = std::size_t(kW) * kH;
   // Left of the edge every finite window residual is kA: v = 0, so kA comes back whole,
   // next to the two bad pixels and on them.
@@ -138,7 +147,7 @@ TEST(BmfrResidual, NonFiniteResidualsTakeNoPart) {
 // A flat wall lit 1.0 with a hard shadow band (8 pixels wide, 0.2) that no feature tells
 // apart, noise free, a static camera: the fit spreads the band over its block; the detail
 // stage brings it back.
-TEST(BmfrResidual, AHardShadowOnAFlatWallComesBack) {
+TEST(BmfrDetail, AHardShadowOnAFlatWallComesBack) {
   const int w = 64, h = 32, band0 = 28, band1 = 36;
   Image colour(w, h, 3), position(w, h, 3), normal(w, h, 3), albedo(w, h, 3, 1.0f), motion(w, h, 4, 0.0f);
   for (int y = 0; y < h; ++y)
