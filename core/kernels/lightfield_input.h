@@ -21,6 +21,11 @@ ParamSpec bounds_radius_param();
 ParamSpec fallback_param();
 ParamSpec mu_param(bool fallback_only);
 ParamSpec bins_param();
+ParamSpec residual_k_param();
+ParamSpec residual_radius_param();
+// residual_k as it applies to this effect: -1 (the default) is 3 for soft shadows and depth of
+// field, 0 for gi (residual_k_param says why).
+double residual_k_for(const Options& o, LightFieldEffect effect);
 
 // Options from a ParamSet holding any of the parameters above (absent ones keep their defaults).
 Options options_from(const ParamSet& params);
@@ -36,8 +41,9 @@ std::shared_ptr<const LightField> lightfield_input(const Frame& frame, const std
 void remodulate(const LightField& lf, const Roi& roi, Image& out);
 
 // What each light-field filter's run() does around its core: decode (and demodulate) the
-// frame's light field, run `core`, multiply the modulation back; returns the notes (the
-// counts, the non-finite values replaced).
+// frame's light field, run `core`, multiply the modulation back, add back what it missed
+// against each pixel's own samples (the frame's flat colour; residual_k); returns the notes
+// (the counts, the non-finite values replaced, the pixels that took their residual).
 using Core = void (*)(const LightField&, const Options&, const Roi&, int, Image&, Counts*);
 std::vector<std::string> run_on_frame(const Frame& frame, const std::string& filter, const Options& o, const Roi& roi,
                                       int nthreads, Image& out, Core core, bool sheared);
