@@ -6,39 +6,13 @@
 #include <cmath>
 
 #include "filters/registry.h"
-#include "pass_testutil.h"
+#include "floor_frame_testutil.h"
 
 namespace mcr {
 namespace {
 
+using testutil::floor_frame;
 using testutil::make_pass;
-
-// A flat floor seen by a static camera (every pixel its own history).
-Frame floor_frame(const Image& colour, const Image& albedo, bool colour_passes, float diffuse) {
-  const int w = colour.width(), h = colour.height();
-  Image pos(w, h, 3), nrm(w, h, 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      pos.at(x, y, 0) = 0.02f * float(x);
-      pos.at(x, y, 1) = 0.02f * float(y);
-      pos.at(x, y, 2) = 1.0f;
-      nrm.at(x, y, 2) = 1.0f;
-    }
-  Frame f;
-  f.width = w;
-  f.height = h;
-  f.path = "synthetic.exr";
-  f.passes.push_back(make_pass(Role::Colour, "Combined", colour));
-  f.passes.push_back(make_pass(Role::Position, "Position", pos, Space::World));
-  f.passes.push_back(make_pass(Role::Normal, "Normal", nrm, Space::World));
-  f.passes.push_back(make_pass(Role::Albedo, "Denoising Albedo", albedo));
-  f.passes.push_back(make_pass(Role::Motion, "Vector", Image(w, h, 4)));
-  if (colour_passes) {
-    f.passes.push_back(make_pass(Role::DiffuseColour, "DiffCol", Image(w, h, 3, diffuse)));
-    f.passes.push_back(make_pass(Role::GlossyColour, "GlossCol", Image(w, h, 3, 1.0f)));
-  }
-  return f;
-}
 
 std::unique_ptr<Filter> bmfr(std::initializer_list<std::pair<const char*, ParamValue>> params = {}) {
   auto f = make_filter("bmfr");

@@ -12,12 +12,10 @@
 #include <vector>
 
 #include "filters/registry.h"
-#include "pass_testutil.h"
+#include "floor_frame_testutil.h"
 
 namespace mcr {
 namespace {
-
-using testutil::make_pass;
 
 thread_local std::vector<float> scratch;  // the window sums' planes, as bmfr keeps them
 
@@ -149,23 +147,11 @@ TEST(ResidualShrink, NonFiniteResidualsTakeNoPart) {
 // stage brings it back.
 TEST(BmfrDetail, AHardShadowOnAFlatWallComesBack) {
   const int w = 64, h = 32, band0 = 28, band1 = 36;
-  Image colour(w, h, 3), position(w, h, 3), normal(w, h, 3), albedo(w, h, 3, 1.0f), motion(w, h, 4, 0.0f);
+  Image colour(w, h, 3);
   for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
+    for (int x = 0; x < w; ++x)
       for (int c = 0; c < 3; ++c) colour.at(x, y, c) = x >= band0 && x < band1 ? 0.2f : 1.0f;
-      position.at(x, y, 0) = 0.05f * float(x);
-      position.at(x, y, 1) = 0.05f * float(y);
-      normal.at(x, y, 2) = 1.0f;
-    }
-  Frame f;
-  f.width = w;
-  f.height = h;
-  f.path = "wall.exr";
-  f.passes.push_back(make_pass(Role::Colour, "Combined", colour));
-  f.passes.push_back(make_pass(Role::Position, "Position", position, Space::World));
-  f.passes.push_back(make_pass(Role::Normal, "Normal", normal, Space::World));
-  f.passes.push_back(make_pass(Role::Albedo, "Denoising Albedo", albedo));
-  f.passes.push_back(make_pass(Role::Motion, "Vector", motion));
+  const Frame f = testutil::floor_frame(colour, Image(w, h, 3, 1.0f));
   auto worst_in_band = [&](double k) {
     auto b = make_filter("bmfr");
     b->set("residual_k", k);
