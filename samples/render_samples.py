@@ -50,12 +50,17 @@ SCENES = {
                            "point lamp (its highlights slide over the chrome) and a dim world; "
                            "indirect clamp off; with the light passes; held out: never used to "
                            "choose settings."),
+    "orbit": ("sequence", "16-frame keyframed camera orbit (2.5 degrees per frame) around blue car "
+                          "paint, a brushed-steel column, a polished gold torus, a walnut block "
+                          "and a glass sphere on a dark glossy turntable, lit by an outdoor HDRI "
+                          "(Blender's courtyard studio light) and a strong sun; indirect clamp "
+                          "off; with the light passes; held out: never used to choose settings."),
 }
-ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome"]
+ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
-         "chrome": "report"}
+         "chrome": "report", "orbit": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
 HALVES = {"sunlit": [16], "showroom": [16], "wall": [16]}
 
@@ -86,6 +91,9 @@ def parse_args():
     p.add_argument("--chrome-size", default="192x108", help="WxH of the chrome sequence")
     p.add_argument("--chrome-ref-spp", type=int, default=512,
                    help="reference spp per frame of the chrome sequence")
+    p.add_argument("--orbit-size", default="192x108", help="WxH of the orbit sequence")
+    p.add_argument("--orbit-ref-spp", type=int, default=512,
+                   help="reference spp per frame of the orbit sequence")
     p.add_argument("--threads", type=int, default=0, help="Cycles threads (0 = all cores)")
     p.add_argument("--blender", default=os.environ.get("BLENDER", "blender"))
     return p.parse_args()
@@ -103,6 +111,8 @@ def seq_settings(args, name):
         return args.metal_size, args.metal_ref_spp
     if name == "chrome":
         return args.chrome_size, args.chrome_ref_spp
+    if name == "orbit":
+        return args.orbit_size, args.orbit_ref_spp
     return args.anim_size, args.anim_ref_spp
 
 
