@@ -113,6 +113,10 @@ Image Reconstruction::run_stage(Stage& stage, Frame& frame, const ExecOptions& o
   const std::size_t ch = std::size_t(colour.channels());
   for (std::size_t i = 0; i < acc.pixel_count(); ++i)
     for (std::size_t c = 0; c < 3; ++c) colour.data()[i * ch + c] = acc.data()[i * 3 + c];
+  if (stage.classes.background)
+    notes_.push_back("accumulation: " + std::to_string(stage.classes.background) +
+                     " background pixels (normal 0: the world, which Blender gives no motion) keep no history "
+                     "brighter than their 3x3 neighbourhood");
   if (stage.accumulator.last_reprojection().cut) notes_.push_back("accumulation: camera cut, history restarted");
   return stage.filter->execute(frame, options);
 }

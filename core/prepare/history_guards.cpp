@@ -14,10 +14,15 @@ AccumulationGuards HistoryGuards::build(const Image& signal, const SurfaceClasse
     g.limit_fresh = fresh_.data();
   }
   alpha_floor_.clear();
-  if (classes.mirror && s.mirror_alpha > 0) {
+  const bool mirrors = classes.mirror && s.mirror_alpha > 0, background = classes.background && s.background_cap;
+  if (mirrors) {
     class_values(classes, SurfaceClasses::kMirror, float(s.mirror_alpha), alpha_floor_);
     g.alpha_floor = alpha_floor_.data();
-    neighbourhood_caps(signal, classes.flags, SurfaceClasses::kMirror, nthreads, cap_);
+  }
+  if (mirrors || background) {
+    const std::uint8_t mask = std::uint8_t((mirrors ? SurfaceClasses::kMirror : 0) |
+                                           (background ? SurfaceClasses::kBackground : 0));
+    neighbourhood_caps(signal, classes.flags, mask, nthreads, cap_);
     g.history_cap = cap_.data();
   }
   return g;

@@ -6,7 +6,10 @@
 //     (history_factor x the history's luminance): a firefly does not enter the history;
 //   - on mirror-like pixels (prepare/surface_classes.h) the new sample's weight is at
 //     least mirror_alpha and the history is no brighter than the current 3x3
-//     neighbourhood's brightest: what a mirror shows does not move with its surface.
+//     neighbourhood's brightest: what a mirror shows does not move with its surface;
+//   - on background pixels (no geometry: Blender writes no motion for the world) the
+//     history is no brighter than the current 3x3 neighbourhood's brightest either: an
+//     environment's bright spot does not stay where the camera left it.
 // The buffers are kept between frames (a sequence allocates once).
 #include <vector>
 
@@ -24,6 +27,7 @@ struct HistoryGuardSettings {
   int limit_radius = 2;
   double history_factor = 4.0;
   double mirror_alpha = 1.0;   // 0: mirrors as any pixel
+  bool background_cap = true;  // false: background pixels as any pixel
 };
 
 class HistoryGuards {

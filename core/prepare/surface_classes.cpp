@@ -31,7 +31,8 @@ void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out) {
   const Pass* diffuse = frame.find(Role::DiffuseColour);
   const Pass* glossy = frame.find(Role::GlossyColour);
   out.colour_passes = diffuse && glossy;
-  std::vector<std::size_t> light(std::size_t(std::max(h, 0)), 0), mirror(light.size(), 0);
+  const Pass* normal = frame.find(Role::Normal);
+  std::vector<std::size_t> light(std::size_t(std::max(h, 0)), 0), mirror(light.size(), 0), background(light.size(), 0);
   parallel_rows(0, h, nthreads, [&](int y) {
     std::uint8_t* f = out.flags.data() + std::size_t(y) * std::size_t(w);
     std::size_t nl = 0, nm = 0;
@@ -58,13 +59,29 @@ void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out) {
           ++nm;
         }
       }
+    if (normal) {
+      const Image& n = normal->image;
+      const int nc = std::min(n.channels(), 3);
+      std::size_t nb = 0;
+      for (int x = 0; x < w; ++x) {
+        const float* q = n.pixel(x, y);
+        bool zero = nc > 0;
+        for (int c = 0; c < nc; ++c) zero = zero && q[c] == 0.0f;  // false for NaN
+        if (zero) {
+          f[x] |= SurfaceClasses::kBackground;
+          ++nb;
+        }
+      }
+      background[std::size_t(y)] = nb;
+    }
     light[std::size_t(y)] = nl;
     mirror[std::size_t(y)] = nm;
   });
-  out.light_in_albedo = out.mirror = 0;
+  out.light_in_albedo = out.mirror = out.background = 0;
   for (std::size_t i = 0; i < light.size(); ++i) {
     out.light_in_albedo += light[i];
     out.mirror += mirror[i];
+    out.background += background[i];
   }
 }
 

@@ -12,6 +12,10 @@
 //     surface trails (the sun's reflection slides over a sphere as the camera moves).
 //     Needs both colour passes (Blender: Diffuse Color, Glossy Color); without them no
 //     pixel is called a mirror and the notes say so.
+//   background: the normal pass is exactly 0 (Blender's world behind everything: normal and
+//     position 0, depth 1e10). Blender writes no motion there (Vector 0), so under a moving
+//     camera an environment's bright spot (an HDRI's sun) would stay in the history of the
+//     pixel it left (held-out `orbit`: 6.4 where the frame shows 0.29).
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -24,11 +28,13 @@ constexpr float kMirrorRatio = 10.0f;
 constexpr float kMirrorGloss = 0.02f;
 
 struct SurfaceClasses {
-  enum : std::uint8_t { kLightInAlbedo = 1, kMirror = 2 };
-  std::vector<std::uint8_t> flags;  // per pixel, 0 = neither
-  std::size_t light_in_albedo = 0, mirror = 0;
+  enum : std::uint8_t { kLightInAlbedo = 1, kMirror = 2, kBackground = 4 };
+  std::vector<std::uint8_t> flags;  // per pixel, 0 = none
+  std::size_t light_in_albedo = 0, mirror = 0, background = 0;
   bool colour_passes = false;  // Diffuse and Glossy Color present: mirrors detectable
+  // A pixel whose albedo holds light or a mirror (bmfr keeps them out of its fit).
   bool any() const { return light_in_albedo + mirror > 0; }
+  static constexpr std::uint8_t kOutOfFit = kLightInAlbedo | kMirror;
 };
 
 // Flags of every pixel of `frame` (a non-finite value never sets a flag).

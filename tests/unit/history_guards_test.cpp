@@ -8,6 +8,7 @@
 #include <random>
 
 #include "image/luminance.h"
+#include "image/pass.h"
 #include "pass_testutil.h"
 #include "prepare/history_guards.h"
 #include "prepare/sample_limits.h"
@@ -213,6 +214,55 @@ TEST(SurfaceClasses, LightInTheAlbedoAndMirrorsFromTheColourPasses) {
   EXPECT_EQ(sc.flags, (std::vector<std::uint8_t>{1, 2, 2, 0}));
   EXPECT_EQ(sc.light_in_albedo, 1u);
   EXPECT_EQ(sc.mirror, 2u);
+}
+
+TEST(SurfaceClasses, TheWorldBehindEverythingHasANormalOfZero) {
+  Frame f;
+  f.width = 4;
+  f.height = 1;
+  Image normal(4, 1, 3, 0.0f);
+  normal.at(1, 0, 2) = 1.0f;                                          // a surface
+  normal.at(2, 0, 0) = std::numeric_limits<float>::quiet_NaN();      // unknown: not background
+  f.passes = {testutil::make_pass(Role::Colour, "Combined", Image(4, 1, 3, 1.0f)),
+              testutil::make_pass(Role::Normal, "Normal", normal, Space::World)};
+  SurfaceClasses sc;
+  classify_surfaces(f, 1, sc);
+  EXPECT_EQ(sc.flags, (std::vector<std::uint8_t>{4, 0, 0, 4}));
+  EXPECT_EQ(sc.background, 2u);
+  EXPECT_FALSE(sc.any());  // nothing bmfr keeps out of its fit
+}
+
+// Blender's world has normal and position 0 and no motion: its history is reprojected in
+// place. Under a moving camera an environment's bright spot leaves a pixel; the guards cut
+// that pixel's history to its current 3x3 neighbourhood (closed form), which the plain
+// average would keep at 10 x 0.8 + 0.2 x 0.3.
+TEST(HistoryGuards, ABackgroundsHistoryIsNoBrighterThanItsNeighbourhood) {
+  const int w = 7, h = 5;
+  const Image zero(w, h, 3, 0.0f);
+  Frame f;
+  f.width = w;
+  f.height = h;
+  f.passes = {testutil::make_pass(Role::Normal, "Normal", zero, Space::World)};
+  SurfaceClasses sc;
+  classify_surfaces(f, 1, sc);
+  ASSERT_EQ(sc.background, std::size_t(w) * h);
+  Image spot = flat(w, h, 0.3f);
+  for (int c = 0; c < 3; ++c) spot.at(3, 2, c) = 10.0f;
+  const Image now = flat(w, h, 0.3f);  // the spot has left
+  for (bool cap : {true, false}) {
+    SCOPED_TRACE(cap);
+    TemporalAccumulator acc(AccumulationParams{0.2, {}});
+    for (int k = 0; k < 8; ++k) acc.accumulate(spot, zero, zero, nullptr, 1);
+    const double history = acc.accumulate(spot, zero, zero, nullptr, 1).at(3, 2, 0);
+    HistoryGuardSettings hs;
+    hs.limit_k = 0;  // the background rule alone
+    hs.background_cap = cap;
+    HistoryGuards guards;
+    acc.set_guards(guards.build(now, sc, hs, 1));
+    const Image& out = acc.accumulate(now, zero, zero, nullptr, 1);
+    EXPECT_NEAR(out.at(3, 2, 0), cap ? 0.3 : 0.8 * history + 0.2 * 0.3, 1e-4);
+    EXPECT_NEAR(out.at(0, 0, 0), 0.3, 1e-6);  // where nothing moved, the same either way
+  }
 }
 
 }  // namespace

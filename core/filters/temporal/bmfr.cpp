@@ -234,6 +234,9 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     note("bmfr: " + std::to_string(classes_.mirror) + " mirror-like pixels (Glossy Color > " +
          rounded_text(kMirrorRatio, 3) + "x Diffuse Color): not demodulated, out of the fit, history weight at least "
          "mirror_alpha and no brighter than the 3x3 neighbourhood");
+  if (classes_.background)
+    note("bmfr: " + std::to_string(classes_.background) + " background pixels (normal 0: the world, which Blender "
+         "gives no motion) keep no phase I history brighter than their 3x3 neighbourhood");
   const Pass* ap = frame.find(Role::Albedo);
   const bool demod = params_.get_bool("albedo_demodulation") && ap;
   if (params_.get_bool("albedo_demodulation") && !ap) note("no albedo pass: the colour is fitted without demodulation");
@@ -297,7 +300,7 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     // Pixels whose albedo holds light, and mirrors, are left out of the fit (it would
     // spread their light over the block) and keep their own accumulated illumination.
     fit_valid_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) fit_valid_[i] = classes_.flags[i] ? 0.0f : counts[i];
+    for (std::size_t i = 0; i < n; ++i) fit_valid_[i] = (classes_.flags[i] & SurfaceClasses::kOutOfFit) ? 0.0f : counts[i];
   }
   fit_blocks(frame, acc1, classes_.any() ? fit_valid_ : counts, fitted_, nthreads);
   if (classes_.any())
