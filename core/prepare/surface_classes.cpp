@@ -31,7 +31,7 @@ void classify_surfaces(const Frame& frame, int nthreads, SurfaceClasses& out) {
   const Pass* diffuse = frame.find(Role::DiffuseColour);
   const Pass* glossy = frame.find(Role::GlossyColour);
   out.colour_passes = diffuse && glossy;
-  const Pass* normal = frame.find(Role::Normal);
+  const Pass* normal = frame.find(Role::Normal, Prefer::Geometry);  // the one the reprojection reads
   std::vector<std::size_t> light(std::size_t(std::max(h, 0)), 0), mirror(light.size(), 0), background(light.size(), 0);
   parallel_rows(0, h, nthreads, [&](int y) {
     std::uint8_t* f = out.flags.data() + std::size_t(y) * std::size_t(w);
