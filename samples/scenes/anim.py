@@ -22,13 +22,6 @@ W, D, H = 5.0, 6.0, 2.8
 FRAMES = (1, 16)
 
 
-def linear_keys(obj):
-    ad = obj.animation_data
-    for fc in ad.action.fcurves:
-        fc.extrapolation = "LINEAR"
-        for kp in fc.keyframe_points:
-            kp.interpolation = "LINEAR"
-
 
 def build():
     scene = C.reset_scene()
@@ -88,7 +81,7 @@ def build():
     cube.keyframe_insert("rotation_euler", frame=FRAMES[0])
     cube.rotation_euler = (0, 0, math.radians(6.0 * (FRAMES[1] - FRAMES[0])))
     cube.keyframe_insert("rotation_euler", frame=FRAMES[1])
-    linear_keys(cube)
+    C.linear_keys(cube)
 
     # Lights: soft ceiling panel (visible) and a window-like emitter on the left wall.
     C.area_light("ceiling_lamp", (0.0, -0.4, H - 0.02), 1.2, 170.0, color=(1.0, 0.93, 0.82),
@@ -105,7 +98,7 @@ def build():
     C.aim(cam, (0.9, 1.0, 0.8))
     cam.keyframe_insert("location", frame=FRAMES[1])
     cam.keyframe_insert("rotation_euler", frame=FRAMES[1])
-    linear_keys(cam)
+    C.linear_keys(cam)
     scene.frame_start, scene.frame_end = FRAMES
     scene.render.fps = 24
     return scene

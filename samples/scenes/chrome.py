@@ -169,10 +169,7 @@ def build():
         C.aim(cam, target)
         cam.keyframe_insert("location", frame=frame)
         cam.keyframe_insert("rotation_euler", frame=frame)
-    for fc in cam.animation_data.action.fcurves:
-        fc.extrapolation = "LINEAR"
-        for kp in fc.keyframe_points:
-            kp.interpolation = "LINEAR"
+    C.linear_keys(cam)
     scene.frame_start, scene.frame_end = FRAMES
     scene.render.fps = 24
     return scene

@@ -508,6 +508,15 @@ def sky_world(scene, sun_elevation_deg, sun_rotation_deg, strength=1.0, sky_type
     return world
 
 
+def linear_keys(obj):
+    """Linear interpolation between an object's keys and linear extrapolation past them, so
+    every frame, the first and the last included, has motion vectors both ways."""
+    for fc in obj.animation_data.action.fcurves:
+        fc.extrapolation = "LINEAR"
+        for kp in fc.keyframe_points:
+            kp.interpolation = "LINEAR"
+
+
 def camera(name, location, look_at, lens=35.0, sensor=36.0, ortho_scale=None):
     """Perspective camera, or orthographic `ortho_scale` metres wide when that is given."""
     data = bpy.data.cameras.new(name)

@@ -34,12 +34,6 @@ ORBIT_RADIUS, ORBIT_HEIGHT = 3.6, 1.25
 ORBIT_START_DEG, ORBIT_STEP_DEG = -22.5, 3.0  # azimuth of the camera around TARGET, per frame
 
 
-def linear_keys(obj):
-    for fc in obj.animation_data.action.fcurves:
-        fc.extrapolation = "LINEAR"
-        for kp in fc.keyframe_points:
-            kp.interpolation = "LINEAR"
-
 
 def key_orbit(cam):
     """A key per frame on a circle around TARGET (so the path is an arc, not a chord)."""
@@ -51,7 +45,7 @@ def key_orbit(cam):
         C.aim(cam, TARGET)
         cam.keyframe_insert("location", frame=frame)
         cam.keyframe_insert("rotation_euler", frame=frame)
-    linear_keys(cam)
+    C.linear_keys(cam)
 
 
 def build():

@@ -63,10 +63,7 @@ def key_orbit(cam):
         C.aim(cam, TARGET)
         cam.keyframe_insert("location", frame=frame)
         cam.keyframe_insert("rotation_euler", frame=frame)
-    for fc in cam.animation_data.action.fcurves:
-        fc.extrapolation = "LINEAR"
-        for kp in fc.keyframe_points:
-            kp.interpolation = "LINEAR"
+    C.linear_keys(cam)
 
 
 def build():
