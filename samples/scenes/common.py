@@ -517,6 +517,20 @@ def linear_keys(obj):
             kp.interpolation = "LINEAR"
 
 
+def key_orbit(cam, target, radius, height, start_deg, step_deg, frames):
+    """A camera key per frame of `frames` (first, last) on a circle of `radius` around
+    `target` at `height`, aimed at it: azimuth start_deg + step_deg per frame (a key every
+    frame, so the path is an arc, not a chord), linear, extrapolated."""
+    tx, ty, _ = target
+    for frame in range(frames[0], frames[1] + 1):
+        a = math.radians(start_deg + step_deg * (frame - frames[0]))
+        cam.location = (tx + radius * math.sin(a), ty - radius * math.cos(a), height)
+        aim(cam, target)
+        cam.keyframe_insert("location", frame=frame)
+        cam.keyframe_insert("rotation_euler", frame=frame)
+    linear_keys(cam)
+
+
 def camera(name, location, look_at, lens=35.0, sensor=36.0, ortho_scale=None):
     """Perspective camera, or orthographic `ortho_scale` metres wide when that is given."""
     data = bpy.data.cameras.new(name)

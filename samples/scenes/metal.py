@@ -34,20 +34,6 @@ ORBIT_RADIUS, ORBIT_HEIGHT = 3.6, 1.25
 ORBIT_START_DEG, ORBIT_STEP_DEG = -22.5, 3.0  # azimuth of the camera around TARGET, per frame
 
 
-
-def key_orbit(cam):
-    """A key per frame on a circle around TARGET (so the path is an arc, not a chord)."""
-    tx, ty, _ = TARGET
-    for frame in range(FRAMES[0], FRAMES[1] + 1):
-        a = math.radians(ORBIT_START_DEG + ORBIT_STEP_DEG * (frame - FRAMES[0]))
-        cam.location = (tx + ORBIT_RADIUS * math.sin(a), ty - ORBIT_RADIUS * math.cos(a),
-                        ORBIT_HEIGHT)
-        C.aim(cam, TARGET)
-        cam.keyframe_insert("location", frame=frame)
-        cam.keyframe_insert("rotation_euler", frame=frame)
-    C.linear_keys(cam)
-
-
 def build():
     scene = C.reset_scene()
     C.set_world(scene, (0.35, 0.45, 0.7), 0.35)
@@ -76,7 +62,7 @@ def build():
     C.sun_light("sun", (r90 - el, 0, az), 6.0, angle_deg=0.6, color=(1.0, 0.94, 0.85))
 
     cam = C.camera("camera", (0.0, -3.2, ORBIT_HEIGHT), TARGET, lens=35.0)
-    key_orbit(cam)
+    C.key_orbit(cam, TARGET, ORBIT_RADIUS, ORBIT_HEIGHT, ORBIT_START_DEG, ORBIT_STEP_DEG, FRAMES)
     scene.frame_start, scene.frame_end = FRAMES
     scene.render.fps = 24
     return scene

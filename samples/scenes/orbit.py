@@ -55,17 +55,6 @@ def hdri_world(scene, name, strength):
     return world
 
 
-def key_orbit(cam):
-    tx, ty, _ = TARGET
-    for frame in range(FRAMES[0], FRAMES[1] + 1):
-        a = math.radians(ORBIT_START_DEG + ORBIT_STEP_DEG * (frame - FRAMES[0]))
-        cam.location = (tx + ORBIT_RADIUS * math.sin(a), ty - ORBIT_RADIUS * math.cos(a), ORBIT_HEIGHT)
-        C.aim(cam, TARGET)
-        cam.keyframe_insert("location", frame=frame)
-        cam.keyframe_insert("rotation_euler", frame=frame)
-    C.linear_keys(cam)
-
-
 def build():
     scene = C.reset_scene()
     hdri_world(scene, "courtyard.exr", 0.8)
@@ -94,7 +83,7 @@ def build():
     C.sphere("glass_sphere", (0.05, -0.05, 0.31), 0.25, C.glass("clear_glass", ior=1.5))
 
     cam = C.camera("camera", (0, -ORBIT_RADIUS, ORBIT_HEIGHT), TARGET, lens=40.0)
-    key_orbit(cam)
+    C.key_orbit(cam, TARGET, ORBIT_RADIUS, ORBIT_HEIGHT, ORBIT_START_DEG, ORBIT_STEP_DEG, FRAMES)
     scene.frame_start, scene.frame_end = FRAMES
     scene.render.fps = 24
     return scene
