@@ -59,12 +59,21 @@ ParamSpec residual_k_param() {
                           "paths, it cost 5-7% at 1-4 spp)");
 }
 ParamSpec residual_radius_param() {
-  return ParamSpec::Int("residual_radius", 2, 1, 4, "half width of the residual's window (residual_k)");
+  return ParamSpec::Int("residual_radius", 0, 0, 4,
+                        "half width of the residual's window (residual_k); 0 = by samples: 2 for up to 4 samples a "
+                        "pixel, 1 from 9 (more own samples are less noisy, and a narrower window follows a sharp "
+                        "penumbra: chosen on the generator's soft shadows and dof, soft shadows at 64 spp 0.00021 "
+                        "-> 0.00011)");
 }
 
 double residual_k_for(const Options& o, LightFieldEffect effect) {
   if (o.residual_k >= 0) return o.residual_k;
   return effect == LightFieldEffect::Gi ? 0.0 : 3.0;
+}
+
+int residual_radius_for(const Options& o, int l) {
+  if (o.residual_radius > 0) return o.residual_radius;
+  return l <= 2 ? 2 : 1;
 }
 
 Options options_from(const ParamSet& params) {
@@ -135,7 +144,7 @@ std::vector<std::string> run_on_frame(const Frame& frame, const std::string& fil
   if (const double k = residual_k_for(o, lf.effect); k > 0) {
     ResidualSettings rs;
     rs.k = k;
-    rs.radius = o.residual_radius;
+    rs.radius = residual_radius_for(o, lf.l);
     std::vector<float> scratch;
     const std::size_t taken = add_back_residual(rs, frame.image(Role::Colour), nullptr,
                                                 {out.data(), std::size_t(out.channels()), 1}, scratch, nthreads);

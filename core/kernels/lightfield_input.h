@@ -26,6 +26,9 @@ ParamSpec residual_radius_param();
 // residual_k as it applies to this effect: -1 (the default) is 3 for soft shadows and depth of
 // field, 0 for gi (residual_k_param says why).
 double residual_k_for(const Options& o, LightFieldEffect effect);
+// residual_radius as it applies to l x l samples a pixel: 0 (the default) is 2 for l <= 2, 1
+// above (residual_radius_param says why).
+int residual_radius_for(const Options& o, int l);
 
 // Options from a ParamSet holding any of the parameters above (absent ones keep their defaults).
 Options options_from(const ParamSet& params);

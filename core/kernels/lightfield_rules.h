@@ -38,7 +38,7 @@ struct Options {
   int bins = 16;              // sheared (factored): bins over b and y2
   // The result's residual against each pixel's own samples added back (kernels/residual_shrink.h):
   double residual_k = -1;     // 0 = off, -1 = by effect (residual_k_for)
-  int residual_radius = 2;
+  int residual_radius = 0;    // 0 = by samples (residual_radius_for)
   // sheared (factored): memory for a band of rows' pre-convolved values (steps 1a, 2a); rows
   // beyond it go to further bands (same result). Not a parameter; tests make it small.
   std::size_t band_bytes = std::size_t(512) << 20;

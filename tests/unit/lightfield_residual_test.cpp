@@ -1,7 +1,8 @@
 // The light-field filters' residual stage (kernels/lightfield_input.h, residual_k): what a
 // filter's window misplaces is pulled back by the pixels' own samples. Oracle: the closed form
 // of a one-slope soft-shadow edge (the light's Gaussian mass below the edge), through the file
-// and the Filter wrappers as a user runs them; the default by effect against explicit settings.
+// and the Filter wrappers as a user runs them; the defaults by effect and by samples against
+// explicit settings.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -23,8 +24,8 @@ using testutil::make_lightfield;
 // A shadow edge of slope 4 (x units = pixels) across the middle of a 64 x 8 receiver: lit where
 // y1 + (X1 - 32) / 4 <= 0.2, the Gaussian light (sigma 0.5) on [-1, 1]; 64 samples a pixel.
 constexpr double kSlope = 4, kC = 0.2;
-LightField edge(LightFieldEffect effect, float declared_slope) {
-  LightField lf = make_lightfield(effect, 64, 8, 8, 1.0f, 0.5f, false);
+LightField edge(LightFieldEffect effect, float declared_slope, int l = 8) {
+  LightField lf = make_lightfield(effect, 64, 8, l, 1.0f, 0.5f, false);
   testutil::jitter_samples(lf, 5);
   testutil::set_slopes(lf, declared_slope, declared_slope);
   testutil::fill_values(lf, [](double X1, double, double y1, double y2) {
@@ -64,12 +65,13 @@ class LightFieldResidual : public testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
   // The light field written and read back as a user's file, filtered by `filter` with `k`
   // (empty: the default).
-  Image run(const LightField& lf, const std::string& filter, const std::string& k) {
+  Image run(const LightField& lf, const std::string& filter, const std::string& k, const std::string& radius = "") {
     const std::string f = (dir_ / "lf.exr").string();
     write_deep_samples(encode_lightfield(lf), f);
     const Frame frame = read_frame(f);
     auto flt = make_filter(filter);
     if (!k.empty()) flt->set_text("residual_k", k);
+    if (!radius.empty()) flt->set_text("residual_radius", radius);
     flt->commit();
     return flt->execute(frame);
   }
@@ -79,7 +81,7 @@ class LightFieldResidual : public testing::Test {
 TEST_F(LightFieldResidual, AMisplacedShadowEdgeIsPulledBackByTheOwnSamples) {
   // Bounds that say slope 8 where the edge has slope 4: the shear maps the neighbours' samples
   // to the wrong place on the light and the penumbra comes out twice as wide (RMS 0.064); the
-  // 64 own samples of each pixel see it where it is (0.028 with them).
+  // 64 own samples of each pixel see it where it is (0.021 with them).
   const LightField lf = edge(LightFieldEffect::SoftShadows, 8.0f);
   for (const char* filter : {"sheared", "sheared4d"}) {
     SCOPED_TRACE(filter);
@@ -100,6 +102,17 @@ TEST_F(LightFieldResidual, TheDefaultFollowsTheEffect) {
     const bool gi = e == LightFieldEffect::Gi;
     EXPECT_EQ(def.storage(), gi ? off.storage() : on.storage());
     EXPECT_NE(on.storage(), off.storage());
+  }
+}
+
+TEST_F(LightFieldResidual, TheWindowNarrowsWithTheSamples) {
+  // 4 samples a pixel: the 5x5 window; 9 and more: 3x3.
+  for (int l : {2, 3, 8}) {
+    SCOPED_TRACE(l);
+    const LightField lf = edge(LightFieldEffect::SoftShadows, 8.0f, l);
+    const Image def = run(lf, "aaf", ""), r1 = run(lf, "aaf", "", "1"), r2 = run(lf, "aaf", "", "2");
+    EXPECT_NE(r1.storage(), r2.storage());
+    EXPECT_EQ(def.storage(), l <= 2 ? r2.storage() : r1.storage());
   }
 }
 
