@@ -147,7 +147,7 @@ std::vector<std::string> run_on_frame(const Frame& frame, const std::string& fil
     rs.radius = residual_radius_for(o, lf.l);
     std::vector<float> scratch;
     const std::size_t taken = add_back_residual(rs, frame.image(Role::Colour), nullptr,
-                                                {out.data(), std::size_t(out.channels()), 1}, scratch, nthreads);
+                                                {out.data(), std::size_t(out.channels()), 1}, roi, scratch, nthreads);
     notes.push_back(filter + ": " + std::to_string(taken) + " pixels took back over half of what the filter missed "
                     "against their own samples (residual_k)");
   }

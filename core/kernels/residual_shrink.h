@@ -8,7 +8,7 @@
 // window (a sheared light-field filter at a penumbra) averages away what the model cannot
 // hold: a hard shadow on a flat wall, a shadow edge its slopes misplace. The unbiased
 // estimate (phase I's accumulation, a pixel's own samples) still holds it, under noise. Per
-// pixel p, over the (2 radius + 1)^2 window W around it (clipped to the frame):
+// pixel p, over the (2 radius + 1)^2 window W around it (clipped to the region filtered):
 //   r(q)  = unbiased(q) x albedo(q) - result(q)   (RGB; the residual of the result)
 //   m, v  = the window's mean and variance of r (per channel), n its finite pixels
 //   w     = clamp(1 - k v_l / (n m_l^2), 0, 1), with m_l, v_l the means over R, G, B
@@ -38,10 +38,10 @@ struct RgbLayout {
 };
 
 // unbiased: w x h x 3 (or more channels; the first three are read); albedo: w x h x 3 or
-// null; result: the filter's, changed in place; scratch: kept by the caller between frames
-// (5 floats per pixel). Returns how many pixels took more than half of their window's mean
-// residual.
+// null; result: the filter's (w x h), changed in place inside roi only, its windows clipped
+// to roi (nothing outside is read); scratch: kept by the caller between frames (5 floats per
+// pixel of roi). Returns how many pixels took more than half of their window's mean residual.
 std::size_t add_back_residual(const ResidualSettings& s, const Image& unbiased, const Image* albedo, RgbLayout result,
-                              std::vector<float>& scratch, int nthreads);
+                              const Roi& roi, std::vector<float>& scratch, int nthreads);
 
 }  // namespace mcr

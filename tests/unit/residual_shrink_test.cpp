@@ -45,9 +45,10 @@ Step step(float albedo) {
 // Closed form at (x, y): the window holds rows * cols pixels, j of its columns left of the
 // edge, so the residual's mean is kA j / cols and its variance kA^2 p (1 - p), p = j / cols:
 // w = 1 - k (1 - p) / (n p), clamped to [0, 1].
-double expected_addition(int x, int y, const ResidualSettings& rs) {
-  const int x0 = std::max(0, x - rs.radius), x1 = std::min(kW - 1, x + rs.radius);
-  const int y0 = std::max(0, y - rs.radius), y1 = std::min(kH - 1, y + rs.radius);
+double expected_addition(int x, int y, const ResidualSettings& rs, const Roi& roi = Roi::all(kW, kH)) {
+  if (!roi.contains(x, y)) return 0.0;
+  const int x0 = std::max(roi.x0, x - rs.radius), x1 = std::min(roi.x1 - 1, x + rs.radius);
+  const int y0 = std::max(roi.y0, y - rs.radius), y1 = std::min(roi.y1 - 1, y + rs.radius);
   const int cols = x1 - x0 + 1, rows = y1 - y0 + 1;
   int j = 0;
   for (int q = x0; q <= x1; ++q) j += q < kEdge;
@@ -57,13 +58,14 @@ double expected_addition(int x, int y, const ResidualSettings& rs) {
   return w * kA * p;
 }
 
-void expect_step_oracle(const Step& s, const std::vector<float>& before, const ResidualSettings& rs) {
+void expect_step_oracle(const Step& s, const std::vector<float>& before, const ResidualSettings& rs,
+                        const Roi& roi = Roi::all(kW, kH)) {
   const std::size_t n = std::size_t(kW) * kH;
   for (int y = 0; y < kH; ++y)
     for (int x = 0; x < kW; ++x)
       for (int c = 0; c < 3; ++c) {
         const std::size_t i = std::size_t(c) * n + std::size_t(y) * kW + std::size_t(x);
-        ASSERT_NEAR(double(s.result[i]) - before[i], expected_addition(x, y, rs), 1e-5) << x << "," << y << " c" << c;
+        ASSERT_NEAR(double(s.result[i]) - before[i], expected_addition(x, y, rs, roi), 1e-5) << x << "," << y << " c" << c;
       }
 }
 
@@ -74,7 +76,7 @@ TEST(ResidualShrink, AStepInTheResidualComesBackAsItsShrunkWindowMean) {
     const std::vector<float> before = s.result;
     ResidualSettings rs;
     rs.radius = radius;
-    add_back_residual(rs, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, scratch, 1);
+    add_back_residual(rs, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, Roi::all(kW, kH), scratch, 1);
     expect_step_oracle(s, before, rs);
     // Deep inside the step the whole residual comes back; past the window, nothing.
     EXPECT_NEAR(s.result[0] - before[0], kA, 1e-6);
@@ -84,10 +86,20 @@ TEST(ResidualShrink, AStepInTheResidualComesBackAsItsShrunkWindowMean) {
     std::vector<float> inter(n * 3);
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t c = 0; c < 3; ++c) inter[i * 3 + c] = before[c * n + i];
-    add_back_residual(rs, s.accumulated, nullptr, {inter.data(), 3, 1}, scratch, 2);
+    add_back_residual(rs, s.accumulated, nullptr, {inter.data(), 3, 1}, Roi::all(kW, kH), scratch, 2);
     for (std::size_t i = 0; i < n; ++i)
       for (std::size_t c = 0; c < 3; ++c) ASSERT_EQ(inter[i * 3 + c], s.result[c * n + i]) << i << " c" << c;
   }
+}
+
+TEST(ResidualShrink, OnlyTheRoiIsReadAndChanged) {
+  // A region across the step: windows end at its border, nothing outside moves.
+  Step s = step(1.0f);
+  const std::vector<float> before = s.result;
+  const Roi roi{3, 2, 17, 8};
+  ResidualSettings rs;
+  add_back_residual(rs, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, roi, scratch, 1);
+  expect_step_oracle(s, before, rs, roi);
 }
 
 TEST(ResidualShrink, WithAnAlbedoTheResidualIsOfTheRemodulatedAccumulation) {
@@ -95,7 +107,8 @@ TEST(ResidualShrink, WithAnAlbedoTheResidualIsOfTheRemodulatedAccumulation) {
   const std::vector<float> before = s.result;
   ResidualSettings rs;
   const std::size_t taken =
-      add_back_residual(rs, s.accumulated, &s.albedo, {s.result.data(), 1, std::size_t(kW) * kH}, scratch, 2);
+      add_back_residual(rs, s.accumulated, &s.albedo, {s.result.data(), 1, std::size_t(kW) * kH}, Roi::all(kW, kH),
+                        scratch, 2);
   expect_step_oracle(s, before, rs);
   EXPECT_GT(taken, std::size_t(kH * (kEdge - 2)));
 }
@@ -115,7 +128,7 @@ TEST(ResidualShrink, NoiseAboutARightFitAddsLittle) {
     std::vector<float> result(n * 3, 0.0f);
     ResidualSettings rs;
     rs.k = k;
-    add_back_residual(rs, acc, nullptr, {result.data(), 1, n}, scratch, 2);
+    add_back_residual(rs, acc, nullptr, {result.data(), 1, n}, Roi::all(w, h), scratch, 2);
     double s2 = 0;
     for (float v : result) s2 += double(v) * v;
     return std::sqrt(s2 / double(result.size()));
@@ -129,7 +142,7 @@ TEST(ResidualShrink, NonFiniteResidualsTakeNoPart) {
   const std::vector<float> before = s.result;
   s.accumulated.at(3, 4, 1) = std::numeric_limits<float>::quiet_NaN();
   s.accumulated.at(5, 2, 0) = std::numeric_limits<float>::infinity();
-  add_back_residual({}, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, scratch, 1);
+  add_back_residual({}, s.accumulated, nullptr, {s.result.data(), 1, std::size_t(kW) * kH}, Roi::all(kW, kH), scratch, 1);
   const std::size_t n = std::size_t(kW) * kH;
   // Left of the edge every finite window residual is kA: v = 0, so kA comes back whole,
   // next to the two bad pixels and on them.

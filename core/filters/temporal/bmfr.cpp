@@ -375,7 +375,8 @@ void BmfrFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     rs.k = params_.get_float("residual_k");
     rs.radius = int(params_.get_int("residual_radius"));
     const std::size_t taken =
-        add_back_residual(rs, acc1, demod ? &albedo_ : nullptr, {res_.data(), 1, n}, residual_scratch_, nthreads);
+        add_back_residual(rs, acc1, demod ? &albedo_ : nullptr, {res_.data(), 1, n}, Roi::all(w, h), residual_scratch_,
+                          nthreads);  // the whole frame: the next frame's TAA history
     note("bmfr: detail the fit missed added back at " + std::to_string(taken) + " pixels (over half their window's "
          "residual against the accumulated frames)");
     if (!use_taa) write_planar_roi(res_.data(), n, w, roi, out, nthreads);
