@@ -23,12 +23,17 @@ ParamSpec mu_param(bool fallback_only);
 ParamSpec bins_param();
 ParamSpec residual_k_param();
 ParamSpec residual_radius_param();
+ParamSpec step_back_param();
+ParamSpec step_back_radius_param();
 // residual_k as it applies to this effect: -1 (the default) is 3 for soft shadows and depth of
 // field, 0 for gi (residual_k_param says why).
 double residual_k_for(const Options& o, LightFieldEffect effect);
 // residual_radius as it applies to l x l samples a pixel: 0 (the default) is 2 for l <= 2, 1
 // above (residual_radius_param says why).
 int residual_radius_for(const Options& o, int l);
+// step_back as it applies to this effect: -1 (the default) is 1 (strata) for soft shadows, 0 for
+// depth of field and gi (step_back_param says why).
+int step_back_for(const Options& o, LightFieldEffect effect);
 
 // Options from a ParamSet holding any of the parameters above (absent ones keep their defaults).
 Options options_from(const ParamSet& params);
@@ -41,12 +46,15 @@ Options options_from(const ParamSet& params);
 // The frame's decoded light field is used as it is (read_frame decodes it once); a frame built
 // in memory with only the deep buffer is decoded here.
 std::shared_ptr<const LightField> lightfield_input(const Frame& frame, const std::string& filter);
+// The same, with the samples as the file holds them (not divided by a modulation).
+std::shared_ptr<const LightField> decoded_lightfield(const Frame& frame, const std::string& filter);
 void remodulate(const LightField& lf, const Roi& roi, Image& out);
 
 // What each light-field filter's run() does around its core: decode (and demodulate) the
 // frame's light field, run `core`, multiply the modulation back, add back what it missed
-// against each pixel's own samples (the frame's flat colour; residual_k); returns the notes
-// (the counts, the non-finite values replaced, the pixels that took their residual).
+// against each pixel's own samples (the frame's flat colour; residual_k), step back toward
+// them where the filter is not estimated to beat them (step_back); returns the notes (the
+// counts, the non-finite values replaced, the pixels that took their residual, the step back).
 using Core = void (*)(const LightField&, const Options&, const Roi&, int, Image&, Counts*);
 std::vector<std::string> run_on_frame(const Frame& frame, const std::string& filter, const Options& o, const Roi& roi,
                                       int nthreads, Image& out, Core core, bool sheared);

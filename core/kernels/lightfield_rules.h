@@ -39,6 +39,11 @@ struct Options {
   // The result's residual against each pixel's own samples added back (kernels/residual_shrink.h):
   double residual_k = -1;     // 0 = off, -1 = by effect (residual_k_for)
   int residual_radius = 0;    // 0 = by samples (residual_radius_for)
+  // The step back toward each pixel's own estimate (kernels/risk_blend.h) with the variance of
+  // its samples (kernels/lightfield_variance.h): -1 by effect (step_back_for), 0 off, 1 strata,
+  // 2 samples; the half width of its window.
+  int step_back = -1;
+  int step_back_radius = 3;
   // sheared (factored): memory for a band of rows' pre-convolved values (steps 1a, 2a); rows
   // beyond it go to further bands (same result). Not a parameter; tests make it small.
   std::size_t band_bytes = std::size_t(512) << 20;

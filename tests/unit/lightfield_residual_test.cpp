@@ -1,8 +1,9 @@
-// The light-field filters' residual stage (kernels/lightfield_input.h, residual_k): what a
-// filter's window misplaces is pulled back by the pixels' own samples. Oracle: the closed form
-// of a one-slope soft-shadow edge (the light's Gaussian mass below the edge), through the file
-// and the Filter wrappers as a user runs them; the defaults by effect and by samples against
-// explicit settings.
+// The light-field filters' residual stage and step back (kernels/lightfield_input.h,
+// residual_k, step_back): what a filter's window misplaces is pulled back by the pixels' own
+// samples. Oracles: the closed form of a one-slope soft-shadow edge (the light's Gaussian mass
+// below the edge), and the generator's soft-shadow scene against its converged render, through
+// the file and the Filter wrappers as a user runs them; the defaults by effect and by samples
+// against explicit settings.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "filters/registry.h"
 #include "io/deep_writer.h"
 #include "io/frame_reader.h"
+#include "generator.h"
 #include "lightfield_testutil.h"
 
 namespace mcr {
@@ -65,13 +67,15 @@ class LightFieldResidual : public testing::Test {
   void TearDown() override { fs::remove_all(dir_); }
   // The light field written and read back as a user's file, filtered by `filter` with `k`
   // (empty: the default).
-  Image run(const LightField& lf, const std::string& filter, const std::string& k, const std::string& radius = "") {
+  Image run(const LightField& lf, const std::string& filter, const std::string& k, const std::string& radius = "",
+            const std::string& step_back = "") {
     const std::string f = (dir_ / "lf.exr").string();
     write_deep_samples(encode_lightfield(lf), f);
     const Frame frame = read_frame(f);
     auto flt = make_filter(filter);
     if (!k.empty()) flt->set_text("residual_k", k);
     if (!radius.empty()) flt->set_text("residual_radius", radius);
+    if (!step_back.empty()) flt->set_text("step_back", step_back);
     flt->commit();
     return flt->execute(frame);
   }
@@ -82,14 +86,18 @@ TEST_F(LightFieldResidual, AMisplacedShadowEdgeIsPulledBackByTheOwnSamples) {
   // Bounds that say slope 8 where the edge has slope 4: the shear maps the neighbours' samples
   // to the wrong place on the light and the penumbra comes out twice as wide (RMS 0.064); the
   // 64 own samples of each pixel see it where it is (0.021 with them).
+  // The step back (on by default for soft shadows) pulls it back too: off here, then both.
   const LightField lf = edge(LightFieldEffect::SoftShadows, 8.0f);
   for (const char* filter : {"sheared", "sheared4d"}) {
     SCOPED_TRACE(filter);
-    const double off = rms_against_exact(lf, run(lf, filter, "0"));
-    const double on = rms_against_exact(lf, run(lf, filter, ""));
-    std::printf("%s, misplaced edge: residual off %.4f, on (default) %.4f\n", filter, off, on);
+    const double off = rms_against_exact(lf, run(lf, filter, "0", "", "off"));
+    const double on = rms_against_exact(lf, run(lf, filter, "", "", "off"));
+    const double both = rms_against_exact(lf, run(lf, filter, ""));
+    std::printf("%s, misplaced edge: residual off %.4f, on %.4f, with the step back (default) %.4f\n", filter, off,
+                on, both);
     EXPECT_GT(off, 0.04);
     EXPECT_LT(on, 0.6 * off);
+    EXPECT_LT(both, 0.6 * off);
   }
 }
 
@@ -113,6 +121,57 @@ TEST_F(LightFieldResidual, TheWindowNarrowsWithTheSamples) {
     const Image def = run(lf, "aaf", ""), r1 = run(lf, "aaf", "", "1"), r2 = run(lf, "aaf", "", "2");
     EXPECT_NE(r1.storage(), r2.storage());
     EXPECT_EQ(def.storage(), l <= 2 ? r2.storage() : r1.storage());
+  }
+}
+
+double relmse(const std::vector<float>& ref, const Image& got) {
+  double s = 0;
+  for (std::size_t i = 0; i < ref.size(); ++i) {
+    const double d = double(got.data()[i]) - ref[i];
+    s += d * d / (double(ref[i]) * ref[i] + 0.01);
+  }
+  return s / double(ref.size());
+}
+
+Image own_estimate(const LightField& lf) {  // each pixel's samples weighted by the light
+  Image out(lf.width, lf.height, 3);
+  const std::size_t n = std::size_t(lf.spp());
+  for (std::size_t p = 0; p < lf.pixels(); ++p) {
+    double s[3] = {0, 0, 0}, sw = 0;
+    for (std::size_t k = p * n; k < (p + 1) * n; ++k) {
+      const double w = double(lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[k])) *
+                       lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[k]);
+      s[0] += w * lf.r[k], s[1] += w * lf.g[k], s[2] += w * lf.b[k], sw += w;
+    }
+    for (int c = 0; c < 3; ++c) out.data()[p * 3 + std::size_t(c)] = float(s[c] / sw);
+  }
+  return out;
+}
+
+TEST_F(LightFieldResidual, WellSampledSoftShadowsAreNoWorseThanTheirOwnSamples) {
+  // The generator's soft shadows at 64 samples a pixel: the filters' windows widen its sharpest
+  // contact shadows (a bias more samples do not shrink), so without the step back `sheared` is
+  // worse than the pixels' own estimate; with it (the default) it is better.
+  const auto gen = lfgen::make_scene("soft_shadows", 128, 128);
+  const LightField lf = lfgen::render_lightfield(*gen, 8, 1, 2);
+  const std::vector<float> ref = lfgen::render_reference(*gen, 32, 2, 2);
+  const double input = relmse(ref, own_estimate(lf));
+  const double off = relmse(ref, run(lf, "sheared", "", "", "off"));
+  const double on = relmse(ref, run(lf, "sheared", "", "", ""));
+  std::printf("soft shadows, 64 spp: input %.3g, sheared with step_back=off %.3g, default %.3g\n", input, off, on);
+  EXPECT_GT(off, input);
+  EXPECT_LT(on, 0.9 * input);
+}
+
+TEST_F(LightFieldResidual, TheStepBackFollowsTheEffect) {
+  // Soft shadows step back with the strata's variance by default; dof and gi do not.
+  for (LightFieldEffect e : {LightFieldEffect::SoftShadows, LightFieldEffect::Dof, LightFieldEffect::Gi}) {
+    SCOPED_TRACE(effect_name(e));
+    const LightField lf = edge(e, 8.0f);
+    const Image def = run(lf, "sheared", "", "", ""), off = run(lf, "sheared", "", "", "off"),
+                strata = run(lf, "sheared", "", "", "strata");
+    EXPECT_EQ(def.storage(), e == LightFieldEffect::SoftShadows ? strata.storage() : off.storage());
+    EXPECT_NE(strata.storage(), off.storage());
   }
 }
 
