@@ -56,9 +56,10 @@ ParamSpec residual_k_param() {
                           "each pixel's window, added back with the James-Stein weight 1 - residual_k x its noise / its "
                           "square (kernels/residual_shrink.h): where a wide window misplaces a shadow edge or a "
                           "defocused one, the pixels' own samples pull it back, noise does not; 0 = off; -1 = 3 for "
-                          "soft shadows and dof, 0 for gi (chosen on the generator's scenes: soft shadows at 16 spp "
-                          "0.00055 -> 0.00038 against the input's 0.00051; on gi, whose own samples are one-bounce "
-                          "paths, it cost 5-7% at 1-4 spp)");
+                          "dof, 1 for soft shadows, 0 for gi (chosen on the generator's scenes: soft shadows at 16 spp "
+                          "0.00055 -> 0.00038 against the input's 0.00051 with 3; with the step back after it, 1 "
+                          "(3 -> 1: 0.000277 -> 0.000259 at 16 spp, 0.0000562 -> 0.0000489 at 64); on gi, whose own "
+                          "samples are one-bounce paths, it cost 5-7% at 1-4 spp)");
 }
 ParamSpec step_back_param() {
   return ParamSpec::Enum("step_back", "auto", {"auto", "strata", "samples", "off"},
@@ -88,7 +89,7 @@ ParamSpec residual_radius_param() {
 
 double residual_k_for(const Options& o, LightFieldEffect effect) {
   if (o.residual_k >= 0) return o.residual_k;
-  return effect == LightFieldEffect::Gi ? 0.0 : 3.0;
+  return effect == LightFieldEffect::Gi ? 0.0 : effect == LightFieldEffect::SoftShadows ? 1.0 : 3.0;
 }
 
 int step_back_for(const Options& o, LightFieldEffect effect) {

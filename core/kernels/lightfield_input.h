@@ -25,7 +25,7 @@ ParamSpec residual_k_param();
 ParamSpec residual_radius_param();
 ParamSpec step_back_param();
 ParamSpec step_back_radius_param();
-// residual_k as it applies to this effect: -1 (the default) is 3 for soft shadows and depth of
+// residual_k as it applies to this effect: -1 (the default) is 1 for soft shadows, 3 for depth of
 // field, 0 for gi (residual_k_param says why).
 double residual_k_for(const Options& o, LightFieldEffect effect);
 // residual_radius as it applies to l x l samples a pixel: 0 (the default) is 2 for l <= 2, 1

@@ -102,14 +102,17 @@ TEST_F(LightFieldResidual, AMisplacedShadowEdgeIsPulledBackByTheOwnSamples) {
 }
 
 TEST_F(LightFieldResidual, TheDefaultFollowsTheEffect) {
-  // Soft shadows and dof take residual_k 3 by default, gi none.
+  // dof takes residual_k 3 by default, soft shadows 1 (with the step back after it), gi none.
   for (LightFieldEffect e : {LightFieldEffect::SoftShadows, LightFieldEffect::Dof, LightFieldEffect::Gi}) {
     SCOPED_TRACE(effect_name(e));
     const LightField lf = edge(e, 2.0f);
-    const Image def = run(lf, "aaf", ""), off = run(lf, "aaf", "0"), on = run(lf, "aaf", "3");
+    const Image def = run(lf, "aaf", ""), off = run(lf, "aaf", "0");
+    const char* k = e == LightFieldEffect::SoftShadows ? "1" : "3";
+    const Image on = run(lf, "aaf", k), other = run(lf, "aaf", e == LightFieldEffect::SoftShadows ? "3" : "1");
     const bool gi = e == LightFieldEffect::Gi;
     EXPECT_EQ(def.storage(), gi ? off.storage() : on.storage());
     EXPECT_NE(on.storage(), off.storage());
+    EXPECT_NE(on.storage(), other.storage());
   }
 }
 
