@@ -56,8 +56,9 @@ ParamSpec residual_k_param() {
                           "each pixel's window, added back with the James-Stein weight 1 - residual_k x its noise / its "
                           "square (kernels/residual_shrink.h): where a wide window misplaces a shadow edge or a "
                           "defocused one, the pixels' own samples pull it back, noise does not; 0 = off; -1 = 3 for "
-                          "dof, 1 for soft shadows, 0 for gi (chosen on the generator's scenes: soft shadows at 16 spp "
-                          "0.00055 -> 0.00038 against the input's 0.00051 with 3; with the step back after it, 1 "
+                          "dof, 0 for gi, 3 for soft shadows too but 1 where the step back follows (chosen on the "
+                          "generator's scenes: soft shadows at 16 spp 0.00055 -> 0.00038 against the input's 0.00051 "
+                          "with 3; with the step back after it, 1 "
                           "(3 -> 1: 0.000277 -> 0.000259 at 16 spp, 0.0000562 -> 0.0000489 at 64); on gi, whose own "
                           "samples are one-bounce paths, it cost 5-7% at 1-4 spp)");
 }
@@ -87,15 +88,17 @@ ParamSpec residual_radius_param() {
                         "-> 0.00011)");
 }
 
-double residual_k_for(const Options& o, LightFieldEffect effect) {
-  if (o.residual_k >= 0) return o.residual_k;
-  return effect == LightFieldEffect::Gi ? 0.0 : effect == LightFieldEffect::SoftShadows ? 1.0 : 3.0;
-}
-
 int step_back_for(const Options& o, LightFieldEffect effect) {
   if (o.step_back >= 0) return o.step_back;
   return effect == LightFieldEffect::SoftShadows ? 1 : 0;
 }
+
+double residual_k_for(const Options& o, LightFieldEffect effect, int spp) {
+  if (o.residual_k >= 0) return o.residual_k;
+  if (effect == LightFieldEffect::Gi) return 0.0;
+  return step_back_for(o, effect) > 0 && spp > 1 ? 1.0 : 3.0;
+}
+
 
 int residual_radius_for(const Options& o, int l) {
   if (o.residual_radius > 0) return o.residual_radius;
@@ -185,7 +188,7 @@ std::vector<std::string> run_on_frame(const Frame& frame, const std::string& fil
   core(lf, o, roi, nthreads, out, &c);
   remodulate(lf, roi, out);
   std::vector<std::string> notes = {counts_note(filter, c, sheared)};
-  if (const double k = residual_k_for(o, lf.effect); k > 0) {
+  if (const double k = residual_k_for(o, lf.effect, lf.spp()); k > 0) {
     ResidualSettings rs;
     rs.k = k;
     rs.radius = residual_radius_for(o, lf.l);

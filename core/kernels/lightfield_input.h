@@ -25,9 +25,10 @@ ParamSpec residual_k_param();
 ParamSpec residual_radius_param();
 ParamSpec step_back_param();
 ParamSpec step_back_radius_param();
-// residual_k as it applies to this effect: -1 (the default) is 1 for soft shadows, 3 for depth of
-// field, 0 for gi (residual_k_param says why).
-double residual_k_for(const Options& o, LightFieldEffect effect);
+// residual_k as it applies to this effect and spp: -1 (the default) is 3 for depth of field and
+// soft shadows, 1 where the step back follows it (step_back_for, 2 samples a pixel or more), 0
+// for gi (residual_k_param says why).
+double residual_k_for(const Options& o, LightFieldEffect effect, int spp);
 // residual_radius as it applies to l x l samples a pixel: 0 (the default) is 2 for l <= 2, 1
 // above (residual_radius_param says why).
 int residual_radius_for(const Options& o, int l);

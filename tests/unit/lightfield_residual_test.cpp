@@ -114,6 +114,12 @@ TEST_F(LightFieldResidual, TheDefaultFollowsTheEffect) {
     EXPECT_NE(on.storage(), off.storage());
     EXPECT_NE(on.storage(), other.storage());
   }
+  // Soft shadows without the step back after it (one sample a pixel, or step_back=off): 3.
+  const LightField one = edge(LightFieldEffect::SoftShadows, 2.0f, 1);
+  EXPECT_EQ(run(one, "aaf", "").storage(), run(one, "aaf", "3").storage());
+  EXPECT_NE(run(one, "aaf", "").storage(), run(one, "aaf", "1").storage());
+  const LightField many = edge(LightFieldEffect::SoftShadows, 2.0f);
+  EXPECT_EQ(run(many, "aaf", "", "", "off").storage(), run(many, "aaf", "3", "", "off").storage());
 }
 
 TEST_F(LightFieldResidual, TheWindowNarrowsWithTheSamples) {
