@@ -58,26 +58,25 @@ ParamSpec residual_k_param() {
                           "defocused one, the pixels' own samples pull it back, noise does not; 0 = off; -1 = 3 for "
                           "dof, 0 for gi, 3 for soft shadows too but 1 where the step back follows (chosen on the "
                           "generator's scenes: soft shadows at 16 spp 0.00055 -> 0.00038 against the input's 0.00051 "
-                          "with 3; with the step back after it, 1 "
-                          "(3 -> 1: 0.000277 -> 0.000259 at 16 spp, 0.0000562 -> 0.0000489 at 64); on gi, whose own "
-                          "samples are one-bounce paths, it cost 5-7% at 1-4 spp)");
+                          "with 3; with the step back after it, 1: 0.000277 -> 0.000259 at 16 spp, 0.0000562 -> "
+                          "0.0000489 at 64; on gi, whose own samples are one-bounce paths, it cost 5-7% at 1-4 spp)");
 }
 ParamSpec step_back_param() {
   return ParamSpec::Enum("step_back", "auto", {"auto", "strata", "samples", "off"},
                          "after the filter, blend toward each pixel's own estimate where the filter is not estimated "
-                         "to beat it (Stein's unbiased risk over a window, kernels/risk_blend.h), with the variance "
-                         "of that estimate from the pixel's samples: strata = from two chequerboard halves of its "
+                         "to beat it (Stein's unbiased risk over a window, kernels/risk_blend.h), with the variance of"
+                         " that estimate from the pixel's samples: strata = from two chequerboard halves of its "
                          "strata, samples = their spread as if independent; off = keep the filter's result; auto = "
-                         "strata for soft shadows (on the generator's scene 1.5-2.1x the true variance at 4-64 spp: it errs "
-                         "high, the safe side), off for depth of field and gi (the dof generator shifts all of a "
-                         "pixel's strata by one jitter, so its halves agree too well: 0.2x the truth at 16 spp, 0.08x "
-                         "at 64; gi 0.74x at 4 spp; a variance that errs low brings the noise back); needs 2 samples a "
-                         "pixel");
+                         "strata for soft shadows (on the generator's scene 1.5-2.1x the true variance at 4-64 spp: it"
+                         " errs high, the safe side), off for depth of field and gi (the dof generator shifts all of a"
+                         " pixel's strata by one jitter, so its halves agree too well: 0.2x the truth at 16 spp, 0.08x"
+                         " at 64; gi 0.74x at 4 spp; a variance that errs low brings the noise back); needs 2 samples "
+                         "a pixel");
 }
 ParamSpec step_back_radius_param() {
   return ParamSpec::Int("step_back_radius", 3, 1, 16,
-                        "half width of the step back's window (step_back; 3 chosen on the generator's soft shadows at 4-64 spp, "
-                        "128 and 64 px wide: within 3% of the best of 1-4 at every spp)");
+                        "half width of the step back's window (step_back; 3 chosen on the generator's soft "
+                        "shadows at 4-64 spp, 128 and 64 px wide: within 3% of the best of 1-4 at every spp)");
 }
 
 ParamSpec residual_radius_param() {
@@ -98,7 +97,6 @@ double residual_k_for(const Options& o, LightFieldEffect effect, int spp) {
   if (effect == LightFieldEffect::Gi) return 0.0;
   return step_back_for(o, effect) > 0 && spp > 1 ? 1.0 : 3.0;
 }
-
 
 int residual_radius_for(const Options& o, int l) {
   if (o.residual_radius > 0) return o.residual_radius;

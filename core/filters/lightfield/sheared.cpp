@@ -19,7 +19,8 @@ const FilterInfo& ShearedFilter::static_info() {
     i.summary = "Fast 4D sheared filter over light-field samples (deep EXR): soft shadows, depth of field, "
                 "indirect light, factored into four 1D steps";
     i.reference = "Yan et al. 2015, eq. 9-15; sec. 5 (16 bins, 32-pixel cap, slope smoothing, axis-aligned fallback)";
-    i.params = with_preparation_params({lf::max_width_param(), lf::residual_k_param(), lf::residual_radius_param(), lf::step_back_param(), lf::step_back_radius_param(),
+    i.params = with_preparation_params({lf::max_width_param(), lf::residual_k_param(), lf::residual_radius_param(),
+                                        lf::step_back_param(), lf::step_back_radius_param(),
                                         lf::bins_param(), lf::fallback_param(),
                                         lf::mu_param(true), lf::smooth_radius_param(), lf::bounds_radius_param(), lf::reject_param(),
                                         lf::normal_degrees_param()},
