@@ -35,6 +35,11 @@ float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range,
   return std::exp(-0.5f * (y / sigma_y) * (y / sigma_y));
 }
 
+float lightfield_sample_weight(const LightField& lf, std::size_t k) {
+  return lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[k]) *
+         lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[k]);
+}
+
 namespace {
 
 const char* const kSampleChannels[] = {"R", "G", "B", "lf.y1", "lf.y2"};

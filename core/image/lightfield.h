@@ -86,6 +86,8 @@ bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield
 // for gi the v-plane truncation (1 inside [-L, L], else 0). A pixel's unfiltered estimate is
 // the mean of its samples weighted by w(y1) w(y2).
 float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range, float y);
+// Sample k's weight in its pixel's unfiltered estimate: w(y1) w(y2).
+float lightfield_sample_weight(const LightField& lf, std::size_t k);
 // Throws Error (BadInput / MissingPass) naming `path` and what is wrong: a missing channel or
 // attribute, a pixel without exactly l*l samples, a non-finite or out-of-range coordinate, a
 // non-finite slope or axis, l outside 1..64. Non-finite values become 0 (and are counted).

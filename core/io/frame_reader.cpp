@@ -100,9 +100,7 @@ void read_deep(ImageInput& in, RawImage& raw, const std::string& path) {
       raw.lightfield = std::make_shared<const LightField>(decode_lightfield(d, path));
       const LightField& lf = *raw.lightfield;
       weight.resize(lf.samples());
-      for (std::size_t i = 0; i < weight.size(); ++i)
-        weight[i] = lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[i]) *
-                    lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[i]);
+      for (std::size_t i = 0; i < weight.size(); ++i) weight[i] = lightfield_sample_weight(lf, i);
     }
     raw.independent_samples = !raw.lightfield;
     raw.names = d.channel_names;

@@ -87,15 +87,15 @@ ParamSpec residual_radius_param() {
                         "-> 0.00011)");
 }
 
-int step_back_for(const Options& o, LightFieldEffect effect) {
-  if (o.step_back >= 0) return o.step_back;
-  return effect == LightFieldEffect::SoftShadows ? 1 : 0;
+Options::StepBack step_back_for(const Options& o, LightFieldEffect effect) {
+  if (o.step_back != Options::StepBack::ByEffect) return o.step_back;
+  return effect == LightFieldEffect::SoftShadows ? Options::StepBack::Strata : Options::StepBack::Off;
 }
 
 double residual_k_for(const Options& o, LightFieldEffect effect, int spp) {
   if (o.residual_k >= 0) return o.residual_k;
   if (effect == LightFieldEffect::Gi) return 0.0;
-  return step_back_for(o, effect) > 0 && spp > 1 ? 1.0 : 3.0;
+  return step_back_for(o, effect) != Options::StepBack::Off && spp > 1 ? 1.0 : 3.0;
 }
 
 int residual_radius_for(const Options& o, int l) {
@@ -116,7 +116,8 @@ Options options_from(const ParamSet& params) {
   if (params.has("residual_radius")) o.residual_radius = int(params.get_int("residual_radius"));
   if (params.has("step_back")) {
     const std::string sb = params.get_enum("step_back");
-    o.step_back = sb == "strata" ? 1 : sb == "samples" ? 2 : sb == "off" ? 0 : -1;
+    using S = Options::StepBack;
+    o.step_back = sb == "strata" ? S::Strata : sb == "samples" ? S::Samples : sb == "off" ? S::Off : S::ByEffect;
   }
   if (params.has("step_back_radius")) o.step_back_radius = int(params.get_int("step_back_radius"));
   if (params.has("bins")) o.bins = int(params.get_int("bins"));
@@ -196,11 +197,11 @@ std::vector<std::string> run_on_frame(const Frame& frame, const std::string& fil
     notes.push_back(filter + ": " + std::to_string(taken) + " pixels took back over half of what the filter missed "
                     "against their own samples (residual_k)");
   }
-  if (const int sb = step_back_for(o, lf.effect); sb > 0 && lf.spp() > 1) {
-    const Image var =
-        estimate_variance(*decoded, sb == 1 ? VarianceFrom::Strata : VarianceFrom::Samples, roi, nthreads);
+  if (const Options::StepBack sb = step_back_for(o, lf.effect); sb != Options::StepBack::Off && lf.spp() > 1) {
+    const bool strata = sb == Options::StepBack::Strata;
+    const Image var = estimate_variance(*decoded, strata ? VarianceFrom::Strata : VarianceFrom::Samples, roi, nthreads);
     const double a = blend_by_risk(frame.image(Role::Colour), var, roi, o.step_back_radius, nthreads, out);
-    notes.push_back(filter + ": step back toward each pixel's own samples (" + (sb == 1 ? "strata" : "samples") +
+    notes.push_back(filter + ": step back toward each pixel's own samples (" + (strata ? "strata" : "samples") +
                     " variance): mean weight of the filter's result " + rounded_text(a, 3));
   }
   if (nonfinite) notes.push_back(filter + ": " + std::to_string(nonfinite) + " non-finite sample values replaced by their pixel's mean");

@@ -32,9 +32,9 @@ double residual_k_for(const Options& o, LightFieldEffect effect, int spp);
 // residual_radius as it applies to l x l samples a pixel: 0 (the default) is 2 for l <= 2, 1
 // above (residual_radius_param says why).
 int residual_radius_for(const Options& o, int l);
-// step_back as it applies to this effect: -1 (the default) is 1 (strata) for soft shadows, 0 for
-// depth of field and gi (step_back_param says why).
-int step_back_for(const Options& o, LightFieldEffect effect);
+// step_back as it applies to this effect: ByEffect (the default) is Strata for soft shadows, Off
+// for depth of field and gi (step_back_param says why).
+Options::StepBack step_back_for(const Options& o, LightFieldEffect effect);
 
 // Options from a ParamSet holding any of the parameters above (absent ones keep their defaults).
 Options options_from(const ParamSet& params);

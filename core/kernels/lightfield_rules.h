@@ -40,9 +40,8 @@ struct Options {
   double residual_k = -1;     // 0 = off, -1 = by effect (residual_k_for)
   int residual_radius = 0;    // 0 = by samples (residual_radius_for)
   // The step back toward each pixel's own estimate (kernels/risk_blend.h) with the variance of
-  // its samples (kernels/lightfield_variance.h): -1 by effect (step_back_for), 0 off, 1 strata,
-  // 2 samples; the half width of its window.
-  int step_back = -1;
+  // its samples (kernels/lightfield_variance.h), and the half width of its window.
+  enum class StepBack { ByEffect, Off, Strata, Samples } step_back = StepBack::ByEffect;
   int step_back_radius = 3;
   // sheared (factored): memory for a band of rows' pre-convolved values (steps 1a, 2a); rows
   // beyond it go to further bands (same result). Not a parameter; tests make it small.

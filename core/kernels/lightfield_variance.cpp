@@ -32,8 +32,7 @@ Image estimate_variance(const LightField& lf, VarianceFrom from, const Roi& roi,
       double sw = 0;
       for (int j = 0; j < n; ++j) {
         const std::size_t k = k0 + std::size_t(j);
-        w[std::size_t(j)] = double(lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[k])) *
-                            lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[k]);
+        w[std::size_t(j)] = lightfield_sample_weight(lf, k);
         half[std::size_t(j)] =
             (stratum(lf.y1[k], lf.y_range, lf.l) + stratum(lf.y2[k], lf.y_range, lf.l)) & 1;
         sw += w[std::size_t(j)];

@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 #include "kernels/window_sums.h"
 #include "util/parallel.h"
@@ -12,16 +14,17 @@ double blend_by_risk(const Image& input, const Image& variance, const Roi& roi, 
   const int w = roi.width(), h = roi.height();
   if (w <= 0 || h <= 0) return 1.0;
   WindowSums var(w, h, false), dev(w, h, false);
-  auto usable = [&](int x, int y) {
-    for (int c = 0; c < 3; ++c)
-      if (!(variance.at(x, y, c) >= 0) || !std::isfinite(variance.at(x, y, c)) || !std::isfinite(input.at(x, y, c)) ||
-          !std::isfinite(out.at(x, y, c)))
-        return false;
-    return true;
-  };
+  // Pixels whose variance is known and whose values are finite: the only ones weighed or blended.
+  std::vector<std::uint8_t> usable(std::size_t(w) * std::size_t(h), 0);
+  auto at = [&](int x, int y) { return std::size_t(y - roi.y0) * std::size_t(w) + std::size_t(x - roi.x0); };
   parallel_rows(roi.y0, roi.y1, nthreads, [&](int y) {
     for (int x = roi.x0; x < roi.x1; ++x) {
-      if (!usable(x, y)) continue;
+      bool ok = true;
+      for (int c = 0; c < 3 && ok; ++c)
+        ok = variance.at(x, y, c) >= 0 && std::isfinite(variance.at(x, y, c)) && std::isfinite(input.at(x, y, c)) &&
+             std::isfinite(out.at(x, y, c));
+      if (!ok) continue;
+      usable[at(x, y)] = 1;
       double sv = 0, sd = 0;
       for (int c = 0; c < 3; ++c) {
         const double f = out.at(x, y, c), d = f - double(input.at(x, y, c));
@@ -42,7 +45,7 @@ double blend_by_risk(const Image& input, const Image& variance, const Roi& roi, 
       const double v = var.value(x - roi.x0, y - roi.y0), d = dev.value(x - roi.x0, y - roi.y0);
       const double a = d > v ? v / d : 1.0;
       s += a;
-      if (a >= 1.0 || !usable(x, y)) continue;
+      if (a >= 1.0 || !usable[at(x, y)]) continue;
       for (int c = 0; c < 3; ++c) {
         const double yv = input.at(x, y, c);
         out.at(x, y, c) = float(yv + a * (double(out.at(x, y, c)) - yv));
