@@ -21,6 +21,10 @@ constexpr int kMinTiles = 4;
 constexpr double kScoreSigmas = 2.0;
 constexpr double kDivergenceSlack = 1.0;  // per-pixel divergence kept in [-slack, 1 + slack]
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
+// The blind-spot check (no variance pass): pixel (x, y) is held out where
+// (x + 2y + phase) % kMaskPeriod == 0, one in five, none of whose four axis neighbours is held out.
+constexpr int kMaskPeriod = 5;
+constexpr int kMasks = 2;          // patterns per tile (phases), each one run of the checked filter
 
 // The frame's passes inside r (a new, smaller frame).
 Frame crop(const Frame& f, const Roi& r) {
@@ -58,13 +62,16 @@ std::vector<Roi> sample_tiles(const Roi& roi, double fraction) {
   return tiles;
 }
 
-// One tile: the cropped frame, its copy with the probe added inside the tile, the noise.
+// One tile: the cropped frame, its copy with the probe added inside the tile, the noise, and
+// without a variance pass its copies with each blind-spot pattern held out.
 struct Sample {
   Frame frame, probed;
   Roi inner;  // the tile, in the crop's coordinates
   NoiseScales noise;
   std::vector<float> sign_over_eps;  // b_c / eps_c per pixel of the tile and channel
   std::vector<float> weight;         // relMSE weight 1 / (local mean_c^2 + 0.01) per pixel and channel
+  std::vector<Frame> masked;         // one per pattern (none with a variance pass)
+  std::vector<std::vector<std::uint8_t>> held;  // per pattern, per pixel of the tile: held out
 };
 
 // relMSE weighs by the reference; the 7x7 mean of the input (fireflies read as their
@@ -91,6 +98,44 @@ std::vector<float> local_weights(const Image& y, const NoiseScales& ns, const Ro
       }
     }
   return w;
+}
+
+// The mean of the four axis neighbours of (x, y), each read as its 3x3 median where it is an
+// outlier (a firefly beside a held-out pixel would otherwise make it a second one, and the
+// pair would pass every filter's outlier rule), into m (RGB); false when one is not finite.
+// The neighbours lie inside the noise's box.
+bool neighbour_mean(const Image& y, const NoiseScales& ns, int x, int yy, float* m) {
+  double sum[3] = {0, 0, 0};
+  for (const auto& [dx, dy] : {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+    const std::size_t j = ns.at(x + dx, yy + dy);
+    if (!ns.finite[j]) return false;
+    const float* q = ns.outlier[j] ? &ns.median[j * 3] : y.pixel(x + dx, yy + dy);
+    for (int c = 0; c < 3; ++c) sum[c] += q[c];
+  }
+  for (int c = 0; c < 3; ++c) m[c] = float(sum[c] / 4.0);
+  return true;
+}
+
+// The frame with the pixels of one blind-spot pattern inside the tile (its outer ring left
+// out: their neighbours must be scored pixels) replaced in the colour by their neighbours'
+// mean: a filter's result there then does not depend on the pixel's own noise. The feature
+// passes stay (they carry the edges the filters follow, and little of the noise).
+Frame hold_out(const Sample& s, int phase, std::vector<std::uint8_t>& held) {
+  Frame m = s.frame;
+  held.assign(std::size_t(s.inner.width()) * s.inner.height(), 0);
+  Pass& colour = const_cast<Pass&>(m.get(Role::Colour));  // the pass the filters read as colour
+  const Image& y = s.frame.image(Role::Colour);
+  float mean[3];
+  std::size_t k = 0;
+  for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
+    for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
+      if ((x + 2 * yy + phase) % kMaskPeriod != 0 || x == s.inner.x0 || yy == s.inner.y0 || x + 1 == s.inner.x1 ||
+          yy + 1 == s.inner.y1 || !s.noise.finite[s.noise.at(x, yy)] || !neighbour_mean(y, s.noise, x, yy, mean))
+        continue;
+      std::copy(mean, mean + 3, colour.image.pixel(x, yy));
+      held[k] = 1;
+    }
+  return m;
 }
 
 Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthreads) {
@@ -123,6 +168,11 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
         s.sign_over_eps[k] = float(b / eps);
       }
     }
+  if (!variance) {
+    s.held.resize(kMasks);
+    for (int j = 0; j < kMasks; ++j)
+      s.masked.push_back(hold_out(s, int((seed + unsigned(2 * j)) % unsigned(kMaskPeriod)), s.held[std::size_t(j)]));
+  }
   return s;
 }
 
@@ -166,6 +216,14 @@ double risk(const Sample& s, const Image& f, const Image& fp) {
   return sum;
 }
 
+// The input's estimated squared error at pixel i, channel c (y: the pixel): its noise
+// variance, or for a far-out pixel its distance to the local median.
+double input_error(const Sample& s, std::size_t i, int c, const float* y) {
+  if (!far_out(s, i)) return s.noise.variance_of(i, c);
+  const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
+  return e * e;
+}
+
 double input_risk(const Sample& s, std::size_t& count) {
   double sum = 0;
   std::size_t k = 0;
@@ -174,14 +232,40 @@ double input_risk(const Sample& s, std::size_t& count) {
       const std::size_t i = s.noise.at(x, yy);
       if (!s.noise.finite[i]) continue;
       const float* y = s.frame.image(Role::Colour).pixel(x, yy);
-      for (int c = 0; c < 3; ++c) {
-        const bool far = far_out(s, i);
-        const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
-        sum += (far ? e * e : s.noise.variance_of(i, c)) * s.weight[k + std::size_t(c)];
-      }
+      for (int c = 0; c < 3; ++c) sum += input_error(s, i, c, y) * s.weight[k + std::size_t(c)];
       count += 3;
     }
   return sum;
+}
+
+// The blind-spot check of one filter on one sample: relMSE-weighted sums over the held-out
+// pixels and channels of the filter's squared distance to the input there, E (f - y)^2 =
+// E (f - x)^2 + E n^2 as f does not depend on the pixel's own noise n (Batson & Royer 2019:
+// whatever the noise's law), and of the input's estimated error (input_risk's terms), the
+// E n^2 to take off.
+struct BlindSpot {
+  double filter = 0, input = 0;
+  std::size_t count = 0;
+};
+
+void blind_spot(const Sample& s, const std::vector<Image>& results, BlindSpot& b) {
+  const Image& y = s.frame.image(Role::Colour);
+  for (std::size_t j = 0; j < s.held.size(); ++j) {
+    std::size_t k = 0;
+    for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
+      for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
+        if (!s.held[j][k]) continue;
+        const std::size_t i = s.noise.at(x, yy);
+        const float* p = y.pixel(x, yy);
+        for (int c = 0; c < 3; ++c) {
+          const double w = s.weight[k * 3 + std::size_t(c)];
+          const double d = double(results[j].at(x, yy, c)) - double(p[c]);
+          b.filter += w * d * d;
+          b.input += w * input_error(s, i, c, p);
+        }
+        b.count += 3;
+      }
+  }
 }
 
 }  // namespace
@@ -191,9 +275,10 @@ const FilterInfo& AutoFilter::static_info() {
     FilterInfo i;
     i.name = "auto";
     i.summary = "Chooses the filter for this render: every image filter the passes allow, scored by SURE on a sample, "
-                "the best run, or the input kept when none is estimated to help";
+                "the best run (without a variance pass once a blind-spot check agrees), or the input kept when none is "
+                "estimated to help";
     i.reference = "Stein's unbiased risk estimate (Stein 1981) with a Monte Carlo divergence (Ramani et al. 2008), "
-                  "over the project's filters with their defaults";
+                  "a blind-spot check (Batson & Royer 2019), over the project's filters with their defaults";
     i.params = {
         ParamSpec::Float("sample_fraction", 0.04, 0.001, 1.0,
                          "share of the region's pixels the candidates are scored on (64x64 tiles on a grid, at least 4; "
@@ -221,6 +306,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   (void)colour;
   scores_.clear();
   chosen_.clear();
+  check_ = {};
   // 1. Candidates: every image filter whose passes this frame has.
   std::vector<std::unique_ptr<Filter>> cands;
   std::string skipped;
@@ -289,9 +375,34 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
          rounded_text(100.0 * params_.get_float("min_gain"), 3) + "%");
     return;  // out holds the input colour
   }
-  chosen_ = best->filter;
   for (auto& f : cands)
-    if (f->info().name == chosen_) {
+    if (f->info().name == best->filter) {
+      // No variance pass: the noise is the image's own estimate, and SURE assumed it Gaussian.
+      // A second estimate that assumes neither must agree that the filter helps.
+      BlindSpot b;
+      if (!samples.front().masked.empty()) {
+        for (const Sample& s : samples) {
+          ExecOptions eo;
+          eo.roi = s.inner;
+          eo.nthreads = nthreads;
+          std::vector<Image> results;
+          for (const Frame& m : s.masked) results.push_back(f->execute(m, eo));
+          blind_spot(s, results, b);
+        }
+      }
+      if (b.count > 0) {  // a region too small to hold a pixel out has no check
+        const double bn = double(b.count);
+        check_ = {best->filter, (b.filter - b.input) / bn, b.input / bn};
+        note("auto: blind-spot check of " + best->filter + " (held-out pixels, no noise law assumed): estimated relMSE " +
+             rounded_text(check_.relmse, 3) + " against the input's " + rounded_text(check_.input, 3));
+        if (!(check_.relmse < (1.0 - params_.get_float("min_gain")) * check_.input)) {
+          chosen_ = "input";
+          note("auto: chose the input as it is: the blind-spot check does not confirm that " + best->filter + " cuts its relMSE by " +
+               rounded_text(100.0 * params_.get_float("min_gain"), 3) + "%");
+          return;  // out holds the input colour
+        }
+      }
+      chosen_ = best->filter;
       ExecOptions eo;
       eo.roi = roi;
       eo.nthreads = nthreads;

@@ -11,7 +11,11 @@
 //     plus eps times random signs), the noise from kernels/noise_scale.h, every channel
 //     weighted as relMSE weighs it.
 //  3. Run the best on the whole region, or copy the input when its own estimated relMSE
-//     is below `converged` or no candidate is estimated to cut it by min_gain.
+//     is below `converged` or no candidate is estimated to cut it by min_gain. Without a
+//     variance pass (SURE's noise then the image's own estimate, its law assumed Gaussian)
+//     the best must also pass a blind-spot check (Batson & Royer 2019): its result at
+//     held-out pixels, made from their neighbours alone, must be estimated to beat the
+//     input there by min_gain too; it errs toward keeping a clean render's detail.
 // What it chose, every score and what each stage skipped go to the notes (`--verbose`,
 // the plugin's and Python's notes).
 #include <string>
@@ -27,6 +31,13 @@ struct AutoScore {
   double seconds = 0;       // time of its two runs on the sample
 };
 
+// The blind-spot check of the best-scored filter (run only without a variance pass).
+struct AutoCheck {
+  std::string filter;       // empty when it did not run
+  double relmse = 0;        // the filter's estimated relMSE at the held-out pixels
+  double input = 0;         // the input's there
+};
+
 class AutoFilter : public Filter {
  public:
   AutoFilter() : Filter(static_info()) {}
@@ -35,6 +46,8 @@ class AutoFilter : public Filter {
   const std::vector<AutoScore>& scores() const { return scores_; }
   // The filter the last execute() ran ("input" when it copied the input).
   const std::string& chosen() const { return chosen_; }
+  // The blind-spot check of the last execute() (filter empty when it did not run).
+  const AutoCheck& check() const { return check_; }
 
  protected:
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
@@ -42,6 +55,7 @@ class AutoFilter : public Filter {
  private:
   std::vector<AutoScore> scores_;
   std::string chosen_;
+  AutoCheck check_;
 };
 
 }  // namespace mcr
