@@ -21,10 +21,10 @@ constexpr int kMinTiles = 4;
 constexpr double kScoreSigmas = 2.0;
 constexpr double kDivergenceSlack = 1.0;  // per-pixel divergence kept in [-slack, 1 + slack]
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
-// The blind-spot check (no variance pass): pixel (x, y) is held out where
-// (x + 2y + phase) % kMaskPeriod == 0, one in five, none of whose four axis neighbours is held out.
+// Without a variance pass, pixel (x, y) is held out where (x + 2y + phase) % kMaskPeriod == 0,
+// one in five, none of whose four axis neighbours is held out.
 constexpr int kMaskPeriod = 5;
-constexpr int kMasks = 2;          // patterns per tile (phases), each one run of the checked filter
+constexpr int kMasks = 1;          // patterns per tile (phases), each one more run of every candidate
 
 // The frame's passes inside r (a new, smaller frame).
 Frame crop(const Frame& f, const Roi& r) {
@@ -62,15 +62,15 @@ std::vector<Roi> sample_tiles(const Roi& roi, double fraction) {
   return tiles;
 }
 
-// One tile: the cropped frame, its copy with the probe added inside the tile, the noise, and
-// without a variance pass its copies with each blind-spot pattern held out.
+// One tile: the cropped frame, the noise, and the copies the candidates also run on: with a
+// variance pass the probed frame (SURE), else one per blind-spot pattern.
 struct Sample {
-  Frame frame, probed;
+  Frame frame, probed;               // probed: with a variance pass
   Roi inner;  // the tile, in the crop's coordinates
   NoiseScales noise;
-  std::vector<float> sign_over_eps;  // b_c / eps_c per pixel of the tile and channel
+  std::vector<float> sign_over_eps;  // b_c / eps_c per pixel of the tile and channel (probed)
   std::vector<float> weight;         // relMSE weight 1 / (local mean_c^2 + 0.01) per pixel and channel
-  std::vector<Frame> masked;         // one per pattern (none with a variance pass)
+  std::vector<Frame> masked;         // one per pattern (without a variance pass)
   std::vector<std::vector<std::uint8_t>> held;  // per pattern, per pixel of the tile: held out
 };
 
@@ -147,6 +147,12 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   const Pass* variance = s.frame.find(Role::Variance);
   s.noise = estimate_noise_scales(y, s.inner, nthreads, variance ? &variance->image : nullptr);
   s.weight = local_weights(y, s.noise, s.inner);
+  if (!variance) {
+    s.held.resize(kMasks);
+    for (int j = 0; j < kMasks; ++j)
+      s.masked.push_back(hold_out(s, int((seed + unsigned(2 * j)) % unsigned(kMaskPeriod)), s.held[std::size_t(j)]));
+    return s;
+  }
   s.probed = s.frame;
   // The pass the filters read as colour (find() picks among several by priority).
   Pass* colour = const_cast<Pass*>(&s.probed.get(Role::Colour));
@@ -168,11 +174,6 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
         s.sign_over_eps[k] = float(b / eps);
       }
     }
-  if (!variance) {
-    s.held.resize(kMasks);
-    for (int j = 0; j < kMasks; ++j)
-      s.masked.push_back(hold_out(s, int((seed + unsigned(2 * j)) % unsigned(kMaskPeriod)), s.held[std::size_t(j)]));
-  }
   return s;
 }
 
@@ -238,19 +239,43 @@ double input_risk(const Sample& s, std::size_t& count) {
   return sum;
 }
 
-// The blind-spot check of one filter on one sample: relMSE-weighted sums over the held-out
-// pixels and channels of the filter's squared distance to the input there, E (f - y)^2 =
-// E (f - x)^2 + E n^2 as f does not depend on the pixel's own noise n (Batson & Royer 2019:
-// whatever the noise's law), and of the input's estimated error (input_risk's terms), the
-// E n^2 to take off.
-struct BlindSpot {
-  double filter = 0, input = 0;
+// Without a variance pass, one candidate's relMSE-weighted sums over a sample's held-out pixels
+// and channels (f: its result on the frame, f_J: on the frame with the pattern held out, which
+// does not depend on the pixel's own noise n; y_J the held-out value, e the input's estimated
+// error, input_error):
+//   score  (f - y)^2 - e + 2 (f - f_J)(y - y_J): E (f - x)^2 = E (f - y)^2 - E n^2 + 2 E n f, and
+//          E n f = E n (f - f_J), read from the pixel's own excursion y - y_J (= n, plus y_J's
+//          error, small beside it) instead of SURE's derivative: no Gaussian law, so a filter
+//          that follows Monte Carlo's bright excursions pays for it. Detail in y - y_J counts
+//          as noise: it errs against a filter that keeps a pixel's detail. Ranks the candidates.
+//   check  (f_J - y)^2 - e: E (f_J - y)^2 = E (f_J - x)^2 + E n^2 (Batson & Royer 2019), the
+//          filter's error as made from a pixel's neighbours alone: errs toward keeping detail.
+//          The best must beat the input by min_gain by it too.
+struct HeldOut {
+  double score = 0, check = 0;
   std::size_t count = 0;
 };
 
-void blind_spot(const Sample& s, const std::vector<Image>& results, BlindSpot& b) {
+// input_risk over the held-out pixels (the input's score without a variance pass).
+double held_input(const Sample& s, std::size_t& count) {
+  const Image& y = s.frame.image(Role::Colour);
+  double sum = 0;
+  for (const std::vector<std::uint8_t>& held : s.held) {
+    std::size_t k = 0;
+    for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
+      for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
+        if (!held[k]) continue;
+        for (int c = 0; c < 3; ++c) sum += s.weight[k * 3 + std::size_t(c)] * input_error(s, s.noise.at(x, yy), c, y.pixel(x, yy));
+        count += 3;
+      }
+  }
+  return sum;
+}
+
+void held_out(const Sample& s, const Image& f, const std::vector<Image>& results, HeldOut& h) {
   const Image& y = s.frame.image(Role::Colour);
   for (std::size_t j = 0; j < s.held.size(); ++j) {
+    const Image& yj = s.masked[j].image(Role::Colour);
     std::size_t k = 0;
     for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
       for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
@@ -258,12 +283,13 @@ void blind_spot(const Sample& s, const std::vector<Image>& results, BlindSpot& b
         const std::size_t i = s.noise.at(x, yy);
         const float* p = y.pixel(x, yy);
         for (int c = 0; c < 3; ++c) {
-          const double w = s.weight[k * 3 + std::size_t(c)];
-          const double d = double(results[j].at(x, yy, c)) - double(p[c]);
-          b.filter += w * d * d;
-          b.input += w * input_error(s, i, c, p);
+          const double w = s.weight[k * 3 + std::size_t(c)], e = input_error(s, i, c, p);
+          const double d = double(f.at(x, yy, c)) - double(p[c]), dj = double(results[j].at(x, yy, c)) - double(p[c]);
+          const double response = double(f.at(x, yy, c)) - double(results[j].at(x, yy, c));
+          h.score += w * (d * d - e + 2.0 * response * (double(p[c]) - double(yj.at(x, yy, c))));
+          h.check += w * (dj * dj - e);
         }
-        b.count += 3;
+        h.count += 3;
       }
   }
 }
@@ -274,11 +300,10 @@ const FilterInfo& AutoFilter::static_info() {
   static const FilterInfo info = [] {
     FilterInfo i;
     i.name = "auto";
-    i.summary = "Chooses the filter for this render: every image filter the passes allow, scored by SURE on a sample, "
-                "the best run (without a variance pass once a blind-spot check agrees), or the input kept when none is "
-                "estimated to help";
+    i.summary = "Chooses the filter for this render: every image filter the passes allow, scored on a sample (SURE with "
+                "a variance pass, else held-out pixels), the best run, or the input kept when none is estimated to help";
     i.reference = "Stein's unbiased risk estimate (Stein 1981) with a Monte Carlo divergence (Ramani et al. 2008), "
-                  "a blind-spot check (Batson & Royer 2019), over the project's filters with their defaults";
+                  "held-out pixels after Batson & Royer 2019, over the project's filters with their defaults";
     i.params = {
         ParamSpec::Float("sample_fraction", 0.04, 0.001, 1.0,
                          "share of the region's pixels the candidates are scored on (64x64 tiles on a grid, at least 4; "
@@ -331,31 +356,50 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   std::size_t count = 0;
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     samples.push_back(make_sample(frame, tiles[t], unsigned(t + 1), nthreads));
-    in_sum += input_risk(samples.back(), count);
+    const Sample& s = samples.back();
+    in_sum += s.masked.empty() ? input_risk(s, count) : held_input(s, count);
   }
   const double n = std::max<double>(double(count), 1.0);
-  scores_.push_back({"input", in_sum / n, 0.0});
+  const bool sure = samples.front().masked.empty();  // a variance pass (every tile alike)
+  std::vector<double> checks;                        // !sure: each candidate's check, as scores_
   for (auto& f : cands) {
     double r = 0;
+    HeldOut h;
     const auto t0 = std::chrono::steady_clock::now();
     for (const Sample& s : samples) {
       ExecOptions eo;
       eo.roi = s.inner;
       eo.nthreads = nthreads;
       const Image a = f->execute(s.frame, eo);
-      const Image b = f->execute(s.probed, eo);
-      r += risk(s, a, b);
+      if (sure) {
+        r += risk(s, a, f->execute(s.probed, eo));
+        continue;
+      }
+      std::vector<Image> results;
+      for (const Frame& m : s.masked) results.push_back(f->execute(m, eo));
+      held_out(s, a, results, h);
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (!sure) {
+      r = h.score;
+      checks.push_back(h.check / n);
+    }
     scores_.push_back({f->info().name, r / n, secs});
   }
+  scores_.push_back({"input", in_sum / n, 0.0});
+  std::vector<std::pair<std::string, double>> check_of;
+  for (std::size_t c = 0; c < checks.size(); ++c) check_of.emplace_back(scores_[c].filter, checks[c]);
   std::stable_sort(scores_.begin(), scores_.end(), [](const AutoScore& a, const AutoScore& b) { return a.relmse < b.relmse; });
   std::string table;
   for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + rounded_text(s.relmse, 3);
   note("auto: estimated relMSE on " + std::to_string(tiles.size()) + (tiles.size() == 1 ? " sample (the whole region)" : " tiles") +
-       " (SURE: only the order counts; below 0 where the noise estimate runs high): " + table);
+       (sure ? " (SURE with the variance pass; only the order counts, below 0 where the noise estimate runs high): "
+             : " (held-out pixels, each scored by its own excursion; only the order counts): ") +
+       table);
 
-  // 3. The best, unless it is not estimated to beat the input by min_gain.
+  // 3. The best, unless it is not estimated to beat the input by min_gain (without a variance
+  // pass, by the check: the ranking score errs against filters that keep detail, so a clean
+  // render would be kept for the wrong reason; the check errs the same way, but less).
   const double input_score = in_sum / n;
   if (input_score < params_.get_float("converged")) {
     chosen_ = "input";
@@ -369,7 +413,15 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       best = &s;
       break;
     }
-  if (!best || !(best->relmse < (1.0 - params_.get_float("min_gain")) * input_score)) {
+  double best_estimate = best ? best->relmse : 0.0;
+  for (const auto& [name, c] : check_of)
+    if (best && name == best->filter) {
+      best_estimate = c;
+      check_ = {name, c, input_score};
+      note("auto: check of " + name + " (its result at the held-out pixels made from their neighbours alone): estimated relMSE " +
+           rounded_text(c, 3) + " against the input's " + rounded_text(input_score, 3));
+    }
+  if (!best || !(best_estimate < (1.0 - params_.get_float("min_gain")) * input_score)) {
     chosen_ = "input";
     note("auto: chose the input as it is: no filter is estimated to cut its relMSE (" + rounded_text(input_score, 3) + ") by " +
          rounded_text(100.0 * params_.get_float("min_gain"), 3) + "%");
@@ -377,31 +429,6 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   }
   for (auto& f : cands)
     if (f->info().name == best->filter) {
-      // No variance pass: the noise is the image's own estimate, and SURE assumed it Gaussian.
-      // A second estimate that assumes neither must agree that the filter helps.
-      BlindSpot b;
-      if (!samples.front().masked.empty()) {
-        for (const Sample& s : samples) {
-          ExecOptions eo;
-          eo.roi = s.inner;
-          eo.nthreads = nthreads;
-          std::vector<Image> results;
-          for (const Frame& m : s.masked) results.push_back(f->execute(m, eo));
-          blind_spot(s, results, b);
-        }
-      }
-      if (b.count > 0) {  // a region too small to hold a pixel out has no check
-        const double bn = double(b.count);
-        check_ = {best->filter, (b.filter - b.input) / bn, b.input / bn};
-        note("auto: blind-spot check of " + best->filter + " (held-out pixels, no noise law assumed): estimated relMSE " +
-             rounded_text(check_.relmse, 3) + " against the input's " + rounded_text(check_.input, 3));
-        if (!(check_.relmse < (1.0 - params_.get_float("min_gain")) * check_.input)) {
-          chosen_ = "input";
-          note("auto: chose the input as it is: the blind-spot check does not confirm that " + best->filter + " cuts its relMSE by " +
-               rounded_text(100.0 * params_.get_float("min_gain"), 3) + "%");
-          return;  // out holds the input colour
-        }
-      }
       chosen_ = best->filter;
       ExecOptions eo;
       eo.roi = roi;

@@ -5,17 +5,21 @@
 //     defaults: each already skips constant or absent feature passes and steps back
 //     toward the input where it is not estimated to help, prepare/step_back.h).
 //  2. Score on a sample: tiles spread over the region (about sample_fraction of its
-//     pixels, each cropped with a margin so the filters see their neighbourhood). Each
-//     candidate's error on them is estimated by Stein's unbiased risk estimate, with its
-//     divergence by a Monte Carlo probe (Ramani et al. 2008: a second run on the input
-//     plus eps times random signs), the noise from kernels/noise_scale.h, every channel
-//     weighted as relMSE weighs it.
+//     pixels, each cropped with a margin so the filters see their neighbourhood), every
+//     channel weighted as relMSE weighs it, the noise from kernels/noise_scale.h.
+//     - With a variance pass: Stein's unbiased risk estimate, the divergence by a Monte
+//       Carlo probe (Ramani et al. 2008: a second run on the input plus eps times random
+//       signs).
+//     - Without (the noise then the image's own estimate, and Monte Carlo's noise skewed,
+//       not Gaussian): held-out pixels (one in five, replaced by their neighbours' mean in a
+//       second run, after Batson & Royer 2019), each candidate scored by
+//       (f - y)^2 - e + 2 (f - f_J)(y - y_J): SURE's E n f taken from the pixel's own
+//       excursion and the filter's response to it instead of a derivative (.cpp).
 //  3. Run the best on the whole region, or copy the input when its own estimated relMSE
-//     is below `converged` or no candidate is estimated to cut it by min_gain. Without a
-//     variance pass (SURE's noise then the image's own estimate, its law assumed Gaussian)
-//     the best must also pass a blind-spot check (Batson & Royer 2019): its result at
-//     held-out pixels, made from their neighbours alone, must be estimated to beat the
-//     input there by min_gain too; it errs toward keeping a clean render's detail.
+//     is below `converged` or the best is not estimated to cut it by min_gain: with a
+//     variance pass by its SURE score, without by a blind-spot check, its result at the
+//     held-out pixels made from their neighbours alone (errs toward keeping a clean
+//     render's detail).
 // What it chose, every score and what each stage skipped go to the notes (`--verbose`,
 // the plugin's and Python's notes).
 #include <string>
