@@ -147,7 +147,9 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   const Pass* variance = s.frame.find(Role::Variance);
   s.noise = estimate_noise_scales(y, s.inner, nthreads, variance ? &variance->image : nullptr);
   s.weight = local_weights(y, s.noise, s.inner);
-  if (!variance) {
+  // Held out without a variance pass, unless the tile is too small to hold out a pixel with
+  // its four neighbours inside (a region under 8x8: then SURE on the image's noise).
+  if (!variance && s.inner.width() >= 8 && s.inner.height() >= 8) {
     s.held.resize(kMasks);
     for (int j = 0; j < kMasks; ++j)
       s.masked.push_back(hold_out(s, int((seed + unsigned(2 * j)) % unsigned(kMaskPeriod)), s.held[std::size_t(j)]));
@@ -360,7 +362,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     in_sum += s.masked.empty() ? input_risk(s, count) : held_input(s, count);
   }
   const double n = std::max<double>(double(count), 1.0);
-  const bool sure = samples.front().masked.empty();  // a variance pass (every tile alike)
+  const bool sure = samples.front().masked.empty();  // a variance pass, or a region under 8x8 (every tile alike)
   std::vector<double> checks;                        // !sure: each candidate's check, as scores_
   for (auto& f : cands) {
     double r = 0;
@@ -393,7 +395,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   std::string table;
   for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + rounded_text(s.relmse, 3);
   note("auto: estimated relMSE on " + std::to_string(tiles.size()) + (tiles.size() == 1 ? " sample (the whole region)" : " tiles") +
-       (sure ? " (SURE with the variance pass; only the order counts, below 0 where the noise estimate runs high): "
+       (sure ? " (SURE; only the order counts, below 0 where the noise estimate runs high): "
              : " (held-out pixels, each scored by its own excursion; only the order counts): ") +
        table);
 

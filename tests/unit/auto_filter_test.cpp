@@ -249,6 +249,28 @@ TEST(AutoFilter, OnlyTheRegionChangesAndNothingNonFiniteLeaves) {
       }
 }
 
+// A region of a few pixels holds no pixel out with its four neighbours inside: it is scored
+// by SURE on the image's noise instead, and a noisy one is still filtered (not kept as
+// "converged" for want of a score).
+TEST(AutoFilter, ARegionTooSmallToHoldOutIsStillScored) {
+  Image clean;
+  const Frame f = blocks(96, 80, 0.4, 9, &clean);
+  const Roi roi{40, 30, 46, 35};
+  AutoFilter a;
+  const Image out = run_auto(f, a, roi);
+  EXPECT_NE(a.chosen(), "input");
+  EXPECT_TRUE(a.check().filter.empty());
+  double in_err = 0, err = 0;
+  for (int yy = roi.y0; yy < roi.y1; ++yy)
+    for (int x = roi.x0; x < roi.x1; ++x)
+      for (int c = 0; c < 3; ++c) {
+        const double r = clean.at(x, yy, c), w = 1.0 / (r * r + 0.01);
+        in_err += w * std::pow(f.image(Role::Colour).at(x, yy, c) - r, 2);
+        err += w * std::pow(out.at(x, yy, c) - r, 2);
+      }
+  EXPECT_LT(err, 0.5 * in_err);
+}
+
 TEST(AutoFilter, TheCatalogNamesIt) {
   const std::vector<std::string> names = catalog_names();
   EXPECT_EQ(names.back(), "auto");
