@@ -22,9 +22,8 @@ constexpr double kScoreSigmas = 2.0;
 constexpr double kDivergenceSlack = 1.0;  // per-pixel divergence kept in [-slack, 1 + slack]
 constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robust noise deviation
 // Without a variance pass, pixel (x, y) is held out where (x + 2y + phase) % kMaskPeriod == 0,
-// one in five, none of whose four axis neighbours is held out.
+// one in five, none of whose four axis neighbours is held out (two patterns ranked no better).
 constexpr int kMaskPeriod = 5;
-constexpr int kMasks = 1;          // patterns per tile (phases), each one more run of every candidate
 
 // The frame's passes inside r (a new, smaller frame).
 Frame crop(const Frame& f, const Roi& r) {
@@ -62,16 +61,24 @@ std::vector<Roi> sample_tiles(const Roi& roi, double fraction) {
   return tiles;
 }
 
-// One tile: the cropped frame, the noise, and the copies the candidates also run on: with a
-// variance pass the probed frame (SURE), else one per blind-spot pattern.
+// A held-out pixel (crop coordinates) with its relMSE weights and the input's estimated error.
+struct HeldPixel {
+  int x, y;
+  double w[3], e[3];
+};
+
+// One tile: the cropped frame, the noise, and the copy the candidates also run on: with a
+// variance pass the probed frame (SURE), else the frame with the held-out pixels replaced.
 struct Sample {
-  Frame frame, probed;               // probed: with a variance pass
+  Frame frame;
+  Frame probed;                      // SURE
+  Frame masked;                      // held out (no passes when SURE)
   Roi inner;  // the tile, in the crop's coordinates
   NoiseScales noise;
-  std::vector<float> sign_over_eps;  // b_c / eps_c per pixel of the tile and channel (probed)
+  std::vector<float> sign_over_eps;  // SURE: b_c / eps_c per pixel of the tile and channel
   std::vector<float> weight;         // relMSE weight 1 / (local mean_c^2 + 0.01) per pixel and channel
-  std::vector<Frame> masked;         // one per pattern (without a variance pass)
-  std::vector<std::vector<std::uint8_t>> held;  // per pattern, per pixel of the tile: held out
+  std::vector<HeldPixel> held;       // held out: the pixels replaced in `masked`
+  bool held_out() const { return !masked.passes.empty(); }
 };
 
 // relMSE weighs by the reference; the 7x7 mean of the input (fireflies read as their
@@ -116,26 +123,44 @@ bool neighbour_mean(const Image& y, const NoiseScales& ns, int x, int yy, float*
   return true;
 }
 
-// The frame with the pixels of one blind-spot pattern inside the tile (its outer ring left
-// out: their neighbours must be scored pixels) replaced in the colour by their neighbours'
+// Whether pixel i is scored by its distance to the local median: beyond its neighbours'
+// range by kScoreSigmas robust deviations, unless a variance pass says its samples agree
+// (NoiseScales::detail: aliased detail of a clean render, not a firefly).
+bool far_out(const Sample& s, std::size_t i) {
+  return s.noise.excess[i] > kScoreSigmas * kScoreSigmas && !s.noise.detail[i];
+}
+
+// The input's estimated squared error at pixel i, channel c (y: the pixel): its noise
+// variance, or for a far-out pixel its distance to the local median.
+double input_error(const Sample& s, std::size_t i, int c, const float* y) {
+  if (!far_out(s, i)) return s.noise.variance_of(i, c);
+  const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
+  return e * e;
+}
+
+// s.masked: s.frame with the pixels of the blind-spot pattern inside the tile (its outer ring
+// left out: their neighbours must be scored pixels) replaced in the colour by their neighbours'
 // mean: a filter's result there then does not depend on the pixel's own noise. The feature
-// passes stay (they carry the edges the filters follow, and little of the noise).
-Frame hold_out(const Sample& s, int phase, std::vector<std::uint8_t>& held) {
-  Frame m = s.frame;
-  held.assign(std::size_t(s.inner.width()) * s.inner.height(), 0);
-  Pass& colour = const_cast<Pass&>(m.get(Role::Colour));  // the pass the filters read as colour
+// passes stay (they carry the edges the filters follow, and little of the noise). s.held: those
+// pixels, each with its weights and the input's estimated error.
+void hold_out(Sample& s, int phase) {
+  s.masked = s.frame;
+  Pass& colour = const_cast<Pass&>(s.masked.get(Role::Colour));  // the pass the filters read as colour
   const Image& y = s.frame.image(Role::Colour);
   float mean[3];
-  std::size_t k = 0;
-  for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
-    for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
-      if ((x + 2 * yy + phase) % kMaskPeriod != 0 || x == s.inner.x0 || yy == s.inner.y0 || x + 1 == s.inner.x1 ||
-          yy + 1 == s.inner.y1 || !s.noise.finite[s.noise.at(x, yy)] || !neighbour_mean(y, s.noise, x, yy, mean))
-        continue;
+  for (int yy = s.inner.y0 + 1; yy + 1 < s.inner.y1; ++yy)
+    for (int x = s.inner.x0 + 1; x + 1 < s.inner.x1; ++x) {
+      const std::size_t i = s.noise.at(x, yy);
+      if ((x + 2 * yy + phase) % kMaskPeriod != 0 || !s.noise.finite[i] || !neighbour_mean(y, s.noise, x, yy, mean)) continue;
       std::copy(mean, mean + 3, colour.image.pixel(x, yy));
-      held[k] = 1;
+      const std::size_t k = std::size_t(yy - s.inner.y0) * std::size_t(s.inner.width()) + std::size_t(x - s.inner.x0);
+      HeldPixel h{x, yy, {}, {}};
+      for (int c = 0; c < 3; ++c) {
+        h.w[c] = s.weight[k * 3 + std::size_t(c)];
+        h.e[c] = input_error(s, i, c, y.pixel(x, yy));
+      }
+      s.held.push_back(h);
     }
-  return m;
 }
 
 Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthreads) {
@@ -150,9 +175,7 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   // Held out without a variance pass, unless the tile is too small to hold out a pixel with
   // its four neighbours inside (a region under 8x8: then SURE on the image's noise).
   if (!variance && s.inner.width() >= 8 && s.inner.height() >= 8) {
-    s.held.resize(kMasks);
-    for (int j = 0; j < kMasks; ++j)
-      s.masked.push_back(hold_out(s, int((seed + unsigned(2 * j)) % unsigned(kMaskPeriod)), s.held[std::size_t(j)]));
+    hold_out(s, int(seed % unsigned(kMaskPeriod)));
     return s;
   }
   s.probed = s.frame;
@@ -179,12 +202,6 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   return s;
 }
 
-// Whether pixel i is scored by its distance to the local median: beyond its neighbours'
-// range by kScoreSigmas robust deviations, unless a variance pass says its samples agree
-// (NoiseScales::detail: aliased detail of a clean render, not a firefly).
-bool far_out(const Sample& s, std::size_t i) {
-  return s.noise.excess[i] > kScoreSigmas * kScoreSigmas && !s.noise.detail[i];
-}
 
 // Sums of the risk estimate of one candidate on one sample, relMSE-weighted.
 double risk(const Sample& s, const Image& f, const Image& fp) {
@@ -219,13 +236,6 @@ double risk(const Sample& s, const Image& f, const Image& fp) {
   return sum;
 }
 
-// The input's estimated squared error at pixel i, channel c (y: the pixel): its noise
-// variance, or for a far-out pixel its distance to the local median.
-double input_error(const Sample& s, std::size_t i, int c, const float* y) {
-  if (!far_out(s, i)) return s.noise.variance_of(i, c);
-  const double e = double(y[c]) - double(s.noise.median[i * 3 + std::size_t(c)]);
-  return e * e;
-}
 
 double input_risk(const Sample& s, std::size_t& count) {
   double sum = 0;
@@ -241,10 +251,9 @@ double input_risk(const Sample& s, std::size_t& count) {
   return sum;
 }
 
-// Without a variance pass, one candidate's relMSE-weighted sums over a sample's held-out pixels
-// and channels (f: its result on the frame, f_J: on the frame with the pattern held out, which
-// does not depend on the pixel's own noise n; y_J the held-out value, e the input's estimated
-// error, input_error):
+// Held out (no variance pass), one candidate's relMSE-weighted sums over a sample's held-out
+// pixels and channels (f: its result on the frame, f_J: on the masked frame, which does not
+// depend on the pixel's own noise n; y_J the held-out value, e the input's estimated error):
 //   score  (f - y)^2 - e + 2 (f - f_J)(y - y_J): E (f - x)^2 = E (f - y)^2 - E n^2 + 2 E n f, and
 //          E n f = E n (f - f_J), read from the pixel's own excursion y - y_J (= n, plus y_J's
 //          error, small beside it) instead of SURE's derivative: no Gaussian law, so a filter
@@ -255,45 +264,27 @@ double input_risk(const Sample& s, std::size_t& count) {
 //          The best must beat the input by min_gain by it too.
 struct HeldOut {
   double score = 0, check = 0;
-  std::size_t count = 0;
 };
 
-// input_risk over the held-out pixels (the input's score without a variance pass).
+// The input's score held out: its estimated error over the held-out pixels.
 double held_input(const Sample& s, std::size_t& count) {
-  const Image& y = s.frame.image(Role::Colour);
   double sum = 0;
-  for (const std::vector<std::uint8_t>& held : s.held) {
-    std::size_t k = 0;
-    for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
-      for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
-        if (!held[k]) continue;
-        for (int c = 0; c < 3; ++c) sum += s.weight[k * 3 + std::size_t(c)] * input_error(s, s.noise.at(x, yy), c, y.pixel(x, yy));
-        count += 3;
-      }
-  }
+  for (const HeldPixel& h : s.held)
+    for (int c = 0; c < 3; ++c) sum += h.w[c] * h.e[c];
+  count += 3 * s.held.size();
   return sum;
 }
 
-void held_out(const Sample& s, const Image& f, const std::vector<Image>& results, HeldOut& h) {
+void held_out_sums(const Sample& s, const Image& f, const Image& fj, HeldOut& sums) {
   const Image& y = s.frame.image(Role::Colour);
-  for (std::size_t j = 0; j < s.held.size(); ++j) {
-    const Image& yj = s.masked[j].image(Role::Colour);
-    std::size_t k = 0;
-    for (int yy = s.inner.y0; yy < s.inner.y1; ++yy)
-      for (int x = s.inner.x0; x < s.inner.x1; ++x, ++k) {
-        if (!s.held[j][k]) continue;
-        const std::size_t i = s.noise.at(x, yy);
-        const float* p = y.pixel(x, yy);
-        for (int c = 0; c < 3; ++c) {
-          const double w = s.weight[k * 3 + std::size_t(c)], e = input_error(s, i, c, p);
-          const double d = double(f.at(x, yy, c)) - double(p[c]), dj = double(results[j].at(x, yy, c)) - double(p[c]);
-          const double response = double(f.at(x, yy, c)) - double(results[j].at(x, yy, c));
-          h.score += w * (d * d - e + 2.0 * response * (double(p[c]) - double(yj.at(x, yy, c))));
-          h.check += w * (dj * dj - e);
-        }
-        h.count += 3;
-      }
-  }
+  const Image& yj = s.masked.image(Role::Colour);
+  for (const HeldPixel& h : s.held)
+    for (int c = 0; c < 3; ++c) {
+      const double p = y.at(h.x, h.y, c), d = double(f.at(h.x, h.y, c)) - p, dj = double(fj.at(h.x, h.y, c)) - p;
+      const double response = double(f.at(h.x, h.y, c)) - double(fj.at(h.x, h.y, c));
+      sums.score += h.w[c] * (d * d - h.e[c] + 2.0 * response * (p - double(yj.at(h.x, h.y, c))));
+      sums.check += h.w[c] * (dj * dj - h.e[c]);
+    }
 }
 
 }  // namespace
@@ -359,12 +350,13 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   for (std::size_t t = 0; t < tiles.size(); ++t) {
     samples.push_back(make_sample(frame, tiles[t], unsigned(t + 1), nthreads));
     const Sample& s = samples.back();
-    in_sum += s.masked.empty() ? input_risk(s, count) : held_input(s, count);
+    in_sum += s.held_out() ? held_input(s, count) : input_risk(s, count);
   }
   const double n = std::max<double>(double(count), 1.0);
-  const bool sure = samples.front().masked.empty();  // a variance pass, or a region under 8x8 (every tile alike)
-  std::vector<double> checks;                        // !sure: each candidate's check, as scores_
-  for (auto& f : cands) {
+  const bool sure = !samples.front().held_out();  // a variance pass, or a region under 8x8 (every tile alike)
+  std::vector<double> estimate(cands.size()), check(cands.size());  // per candidate, relMSE per channel
+  for (std::size_t c = 0; c < cands.size(); ++c) {
+    Filter& f = *cands[c];
     double r = 0;
     HeldOut h;
     const auto t0 = std::chrono::steady_clock::now();
@@ -372,25 +364,18 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       ExecOptions eo;
       eo.roi = s.inner;
       eo.nthreads = nthreads;
-      const Image a = f->execute(s.frame, eo);
-      if (sure) {
-        r += risk(s, a, f->execute(s.probed, eo));
-        continue;
-      }
-      std::vector<Image> results;
-      for (const Frame& m : s.masked) results.push_back(f->execute(m, eo));
-      held_out(s, a, results, h);
+      const Image a = f.execute(s.frame, eo);
+      if (sure)
+        r += risk(s, a, f.execute(s.probed, eo));
+      else
+        held_out_sums(s, a, f.execute(s.masked, eo), h);
     }
     const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    if (!sure) {
-      r = h.score;
-      checks.push_back(h.check / n);
-    }
-    scores_.push_back({f->info().name, r / n, secs});
+    estimate[c] = (sure ? r : h.score) / n;
+    check[c] = h.check / n;
+    scores_.push_back({f.info().name, estimate[c], secs});
   }
   scores_.push_back({"input", in_sum / n, 0.0});
-  std::vector<std::pair<std::string, double>> check_of;
-  for (std::size_t c = 0; c < checks.size(); ++c) check_of.emplace_back(scores_[c].filter, checks[c]);
   std::stable_sort(scores_.begin(), scores_.end(), [](const AutoScore& a, const AutoScore& b) { return a.relmse < b.relmse; });
   std::string table;
   for (const AutoScore& s : scores_) table += (table.empty() ? "" : ", ") + s.filter + " " + rounded_text(s.relmse, 3);
@@ -399,9 +384,9 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
              : " (held-out pixels, each scored by its own excursion; only the order counts): ") +
        table);
 
-  // 3. The best, unless it is not estimated to beat the input by min_gain (without a variance
-  // pass, by the check: the ranking score errs against filters that keep detail, so a clean
-  // render would be kept for the wrong reason; the check errs the same way, but less).
+  // 3. The best, unless it is not estimated to beat the input by min_gain (held out, by the
+  // check: the ranking score errs against filters that keep detail, so a clean render would be
+  // kept for the wrong reason; the check errs the same way, but less).
   const double input_score = in_sum / n;
   if (input_score < params_.get_float("converged")) {
     chosen_ = "input";
@@ -409,37 +394,30 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
          rounded_text(params_.get_float("converged"), 3) + ")");
     return;
   }
-  const AutoScore* best = nullptr;
-  for (const AutoScore& s : scores_)
-    if (s.filter != "input") {
-      best = &s;
-      break;
-    }
-  double best_estimate = best ? best->relmse : 0.0;
-  for (const auto& [name, c] : check_of)
-    if (best && name == best->filter) {
-      best_estimate = c;
-      check_ = {name, c, input_score};
-      note("auto: check of " + name + " (its result at the held-out pixels made from their neighbours alone): estimated relMSE " +
-           rounded_text(c, 3) + " against the input's " + rounded_text(input_score, 3));
-    }
-  if (!best || !(best_estimate < (1.0 - params_.get_float("min_gain")) * input_score)) {
+  // The first of the lowest, as the stable sort above lists them.
+  const std::size_t best = std::size_t(std::min_element(estimate.begin(), estimate.end()) - estimate.begin());
+  double best_estimate = best < cands.size() ? estimate[best] : 0.0;
+  if (best < cands.size() && !sure) {
+    const std::string& name = cands[best]->info().name;
+    best_estimate = check[best];
+    check_ = {name, check[best], input_score};
+    note("auto: check of " + name + " (its result at the held-out pixels made from their neighbours alone): estimated relMSE " +
+         rounded_text(check[best], 3) + " against the input's " + rounded_text(input_score, 3));
+  }
+  if (best == cands.size() || !(best_estimate < (1.0 - params_.get_float("min_gain")) * input_score)) {
     chosen_ = "input";
     note("auto: chose the input as it is: no filter is estimated to cut its relMSE (" + rounded_text(input_score, 3) + ") by " +
          rounded_text(100.0 * params_.get_float("min_gain"), 3) + "%");
     return;  // out holds the input colour
   }
-  for (auto& f : cands)
-    if (f->info().name == best->filter) {
-      chosen_ = best->filter;
-      ExecOptions eo;
-      eo.roi = roi;
-      eo.nthreads = nthreads;
-      out = f->execute(frame, eo);
-      note("auto: chose " + chosen_ + " with its defaults");
-      for (const std::string& m : f->notes()) note(m.rfind(chosen_ + ":", 0) == 0 ? m : chosen_ + ": " + m);
-      return;
-    }
+  Filter& f = *cands[best];
+  chosen_ = f.info().name;
+  ExecOptions eo;
+  eo.roi = roi;
+  eo.nthreads = nthreads;
+  out = f.execute(frame, eo);
+  note("auto: chose " + chosen_ + " with its defaults");
+  for (const std::string& m : f.notes()) note(m.rfind(chosen_ + ":", 0) == 0 ? m : chosen_ + ": " + m);
 }
 
 }  // namespace mcr

@@ -11,8 +11,9 @@
 //       Carlo probe (Ramani et al. 2008: a second run on the input plus eps times random
 //       signs).
 //     - Without (the noise then the image's own estimate, and Monte Carlo's noise skewed,
-//       not Gaussian; a region under 8x8 by SURE on that estimate): held-out pixels (one in five, replaced by their neighbours' mean in a
-//       second run, after Batson & Royer 2019), each candidate scored by
+//       not Gaussian; a region under 8x8 by SURE on that estimate): held-out pixels (one in
+//       five, replaced by their neighbours' mean in the second run, after Batson & Royer
+//       2019), each candidate scored by
 //       (f - y)^2 - e + 2 (f - f_J)(y - y_J): SURE's E n f taken from the pixel's own
 //       excursion and the filter's response to it instead of a derivative (.cpp).
 //  3. Run the best on the whole region, or copy the input when its own estimated relMSE
