@@ -11,6 +11,7 @@
 #include "io/atomic_write.h"
 #include "io/exr_output.h"
 #include "io/sequence.h"
+#include "json_views.h"
 #include "pipeline/denoise_session.h"
 #include "pipeline/sequence_plan.h"
 #include "progress.h"
@@ -26,6 +27,7 @@ struct DenoiseArgs {
   std::string half;  // the other half buffer (a pattern for sequences)
   std::vector<std::string> sets, passes;
   bool keep_passes = false, keep_components = false, timings = false, verbose = false, resume = false;
+  bool json = false;  // --json: a JSON line per frame on stdout
   bool accumulate = false;  // the accumulation stage before the filter
   bool serial = false;      // --serial: no overlap of read, filter and write
   bool pipelined = false;   // --pipelined: overlap them whatever the core count
@@ -56,6 +58,24 @@ std::string times_text(const StageTimes& t) {
   std::snprintf(buf, sizeof buf, "read %.1f ms, filter %.1f ms, write %.1f ms, total %.1f ms", t.read_ms,
                 t.filter_ms, t.write_ms, t.total_ms());
   return buf;
+}
+
+// --json: one frame's record, a line of its own on stdout (JSON Lines: a sequence's frames
+// can be read as they come). output empty: a frame read for a temporal filter's history only.
+void print_record(const std::string& input, const std::string& output, DenoiseSession& session, const StageTimes& t) {
+  nlohmann::json chosen = nullptr;
+  if (!t.choices.empty()) {
+    chosen = nlohmann::json::object();
+    for (const StageChoice& c : t.choices) chosen[c.stage] = c.filter;
+  }
+  const nlohmann::json j = {{"input", input},
+                            {"output", output.empty() ? nlohmann::json(nullptr) : nlohmann::json(output)},
+                            {"filter", session.filter().info().name},
+                            {"parameters", session.reconstruction().parameters_text()},
+                            {"chosen", chosen},
+                            {"notes", t.notes},
+                            {"ms", {{"read", number(t.read_ms)}, {"filter", number(t.filter_ms)}, {"write", number(t.write_ms)}}}};
+  std::cout << j.dump() << std::endl;  // flushed: a farm's log shows each frame as it is done
 }
 
 int run_denoise(const DenoiseArgs& a) {
@@ -170,6 +190,7 @@ int run_denoise(const DenoiseArgs& a) {
                                                   bar->step(d, "statistics passes, then the filter");
                                                 });
       if (bar) bar->finish(a.output);
+      if (a.json) print_record(input_of(list[i]), output_of(list[i]), session, t);
       if (a.verbose)
         for (const auto& n : t.notes)
           if (std::find(unused.begin(), unused.end(), n) == unused.end())
@@ -213,6 +234,7 @@ int run_denoise(const DenoiseArgs& a) {
     sum.filter_ms += t.filter_ms;
     sum.write_ms += t.write_ms;
     out.empty() ? ++replayed : ++written;
+    if (a.json) print_record(in, out, session, t);
     if (a.verbose)
       for (const auto& n : t.notes)
         if (std::find(unused.begin(), unused.end(), n) == unused.end()) std::cerr << "mcrecon: " << in << ": " << n << "\n";
@@ -289,6 +311,10 @@ Run add_denoise(CLI::App& app) {
   app.add_option("--band-rows", a->band_rows, "one frame in bands of N rows (a multiple of 64; see --max-memory)")
       ->check(CLI::Range(1, 1 << 24));
   app.add_flag("--timings", a->timings, "print read / filter / write times per frame");
+  app.add_flag("--json", a->json,
+               "a JSON object per frame on standard output, a line each: input, output (null for a frame read "
+               "for history only), filter, parameters, chosen (filter auto: what it ran, per stage: {\"beauty\": "
+               "\"atrous\"} or the light stages; else null), notes, ms (read, filter, write)");
   app.add_flag("-v,--verbose", a->verbose, "timings plus the filter's notes");
   return [a] { return run_denoise(*a); };
 }

@@ -6,7 +6,8 @@
 //         image filters every channel it is given and writes a real EXR there.
 // Both run a Reconstruction (accumulate=1: the accumulation stage before the filter)
 // with per-stream history (history.h), and describe the run in the header:
-// mcreconFilter, mcreconParameters, mcreconNotes (unused settings, the run's notes).
+// mcreconFilter, mcreconParameters, mcreconChosen (what filter auto ran), mcreconNotes (unused
+// settings, the run's notes).
 //
 // OIIO 2.4 hazards this file is built around (see the shared notes):
 // - OIIO 2.4 offers a file that failed its own reader to every reader, ours
@@ -86,6 +87,7 @@ struct Result {
   int width = 0, height = 0;
   std::vector<float> rgba;
   std::string notes;  // the reconstruction's notes after the run (mcreconNotes)
+  std::string chosen;  // filter auto: what it ran (mcreconChosen)
 };
 
 std::mutex g_cache_mutex;  // guards g_results; never held across an OIIO call
@@ -115,6 +117,7 @@ struct Filtered {
   mcr::Image rgb;
   std::vector<mcr::ComponentImage> components;  // with r.keep_components: the light components
   std::string notes;  // mp::notes_text of the reconstruction's notes after the run
+  std::string chosen;  // mcr::choices_text: what filter auto ran
 };
 
 // Runs the request's reconstruction (accumulation, filter) on one frame with the
@@ -127,6 +130,7 @@ Filtered run_filter(const mp::Request& r, const std::string& settings, const std
     if (r.keep_components) mcr::check_keep_components(lease.reconstruction->filter().params());
     f.rgb = lease.reconstruction->run(frame, {}, r.keep_components ? &f.components : nullptr);
     f.notes = mp::notes_text(lease.reconstruction->notes());
+    f.chosen = mcr::choices_text(lease.reconstruction->choices());
     g_history.done();
     return f;
   } catch (...) {
@@ -135,10 +139,12 @@ Filtered run_filter(const mp::Request& r, const std::string& settings, const std
   }
 }
 
-// What the output's header says of the run: filter, every setting, notes (when any).
+// What the output's header says of the run: filter, every setting, what auto chose and the
+// notes (when any).
 std::vector<std::pair<std::string, std::string>> description(const std::string& filter, const std::string& params,
-                                                             const std::string& notes) {
+                                                             const std::string& notes, const std::string& chosen) {
   std::vector<std::pair<std::string, std::string>> d = {{"mcreconFilter", filter}, {"mcreconParameters", params}};
+  if (!chosen.empty()) d.emplace_back("mcreconChosen", chosen);
   if (!notes.empty()) d.emplace_back("mcreconNotes", notes);
   return d;
 }
@@ -165,7 +171,7 @@ class McreconInput final : public ImageInput {
     close();
     int width = 1, height = 1;
     mcr::PixelWindow window;
-    std::string params_text, notes;
+    std::string params_text, notes, chosen;
     try {
       auto [source, query] = mp::split_name(name);
       mp::KeyValues settings = plugin_attributes(config);
@@ -177,7 +183,10 @@ class McreconInput final : public ImageInput {
       notes = mp::notes_text(reconstruction->notes());  // the unused settings, before any run
       settings_ = mp::settings_key(request_, params_text);
       key_ = settings_ + '\n' + source + '\n' + file_stamp(source);
-      if (const auto done = cached_result(key_)) notes = done->notes;  // plain data: no OIIO call
+      if (const auto done = cached_result(key_)) {  // plain data: no OIIO call
+        notes = done->notes;
+        chosen = done->chosen;
+      }
       const ImageSpec src = source_header(source);
       width = src.width;
       height = src.height;
@@ -192,7 +201,7 @@ class McreconInput final : public ImageInput {
     m_spec.alpha_channel = 3;
     m_spec.attribute("Software", "mcrecon");
     if (deferred_error_.empty()) {
-      for (const auto& [name, value] : description(request_.filter, params_text, notes)) m_spec.attribute(name, value);
+      for (const auto& [name, value] : description(request_.filter, params_text, notes, chosen)) m_spec.attribute(name, value);
       m_spec.attribute("mcreconSource", request_.source);
     } else {
       m_spec.attribute("mcreconError", deferred_error_);
@@ -225,6 +234,7 @@ class McreconInput final : public ImageInput {
     }
     if (!ensure_result()) return false;
     if (!result_->notes.empty()) m_spec.attribute("mcreconNotes", result_->notes);  // the run's notes too
+    if (!result_->chosen.empty()) m_spec.attribute("mcreconChosen", result_->chosen);
     const std::size_t row = std::size_t(m_spec.width) * 4;
     std::memcpy(data, result_->rgba.data() + std::size_t(ybegin - m_spec.y) * row,
                 std::size_t(yend - ybegin) * row * sizeof(float));
@@ -258,6 +268,7 @@ class McreconInput final : public ImageInput {
       const mcr::Image& rgb = filtered.rgb;
       auto r = std::make_shared<Result>();
       r->notes = filtered.notes;
+      r->chosen = filtered.chosen;
       r->width = frame.width;
       r->height = frame.height;
       r->rgba.resize(std::size_t(frame.width) * frame.height * 4);
@@ -391,7 +402,7 @@ class McreconOutput final : public ImageOutput {
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;
       wo.compression = request_.compression;
-      wo.attributes = description(request_.filter, params_text_, filtered.notes);
+      wo.attributes = description(request_.filter, params_text_, filtered.notes, filtered.chosen);
       for (const mcr::ComponentImage& c : filtered.components)
         wo.layers.emplace_back(mcr::component_layer_prefix(frame.layer) + c.name, &c.rgb);
       mcr::write_result(name_, filtered.rgb, frame, wo);

@@ -91,12 +91,6 @@ std::unique_ptr<Reconstruction> make_reconstruction(const Request& r) {
   return std::make_unique<Reconstruction>(make_committed_filter(r.filter, r.params), r.accumulate);
 }
 
-std::string notes_text(const std::vector<std::string>& notes) {
-  std::string text;
-  for (const std::string& n : notes) text += (text.empty() ? "" : "; ") + n;
-  return text;
-}
-
 std::string settings_key(const Request& r, const std::string& canonical_params) {
   std::string key = "filter=" + r.filter + " layer=" + r.read.layer;
   for (const PassOverride& o : r.read.overrides) key += std::string(" ") + role_name(o.role) + "=" + o.value;

@@ -49,9 +49,8 @@ Request make_request(const std::string& source, const KeyValues& settings, bool 
 // stage: parameter errors surface here.
 std::unique_ptr<Reconstruction> make_reconstruction(const Request& r);
 
-// The reconstruction's notes (unused settings first) as one line, "; " between them:
-// the mcreconNotes attribute.
-std::string notes_text(const std::vector<std::string>& notes);
+// The reconstruction's notes as the mcreconNotes attribute (pipeline/reconstruction.h).
+using mcr::notes_text;
 
 // "filter=box layer= normal=... accumulate=0 radius=3": a stable text of what determines the
 // result (after the filter canonicalised its parameters), to key caches and history.

@@ -348,6 +348,14 @@ py::dict times_dict(const mcr::StageTimes& t) {
   return d;
 }
 
+// filter auto's choice per stage ({"beauty": "atrous"}, or the light stages'), None for another filter.
+py::object choices_dict(const std::vector<mcr::StageChoice>& choices) {
+  if (choices.empty()) return py::none();
+  py::dict d;
+  for (const mcr::StageChoice& c : choices) d[py::str(c.stage)] = c.filter;
+  return std::move(d);
+}
+
 // ------------------------------------------------------------------ Session
 
 // One reconstruction (optional accumulation stage + a filter committed once), with
@@ -374,6 +382,14 @@ class Session {
   std::vector<std::string> notes() {
     py::gil_scoped_release release;
     return session_.reconstruction().notes();
+  }
+  py::object chosen() {
+    std::vector<mcr::StageChoice> c;
+    {
+      py::gil_scoped_release release;
+      c = session_.reconstruction().choices();
+    }
+    return choices_dict(c);
   }
   void reset() {
     py::gil_scoped_release release;
@@ -410,6 +426,7 @@ class Session {
     // bands: the bands, then every band's notes once.
     if (max_memory_mb > 0) d["notes"] = t.notes;
     else d["notes"] = notes();
+    d["chosen"] = choices_dict(t.choices);
     return d;
   }
 
@@ -486,6 +503,9 @@ PYBIND11_MODULE(mcrecon, m) {
       .def("needs", &Session::needs, "the passes these settings need and use, as mcrecon.needs()")
       .def("notes", &Session::notes,
            "settings given that have no effect, then the notes of the last run (filter, accumulation)")
+      .def("chosen", &Session::chosen,
+           "filter 'auto': what it ran in the last run, per stage ({'beauty': 'atrous'}, or the light stages' "
+           "with components=light_passes; 'input' where it kept the input); None for another filter")
       .def("reset", &Session::reset, "drop temporal history (new shot)")
       .def(
           "denoise",
@@ -552,7 +572,8 @@ PYBIND11_MODULE(mcrecon, m) {
       "keep_components=True: --keep-components, with params={'components': 'light_passes'}; display={'view': "
       "'Filmic', 'look': ..., 'exposure': ..., 'gamma': ..., 'bit_depth': 8 or 16}: --view etc. for a "
       ".png/.jpg/.tif output); returns "
-      "stage timings and the notes `--verbose` prints (filter='auto': the scores and the filter chosen).");
+      "stage timings, the notes `--verbose` prints (filter='auto': the scores and the filter chosen) and 'chosen' "
+      "(Session.chosen()).");
 
   m.def(
       "denoise_sequence",

@@ -39,6 +39,14 @@ void keep_freed_memory() {
 #endif
 }
 
+// What the output's header says of the run besides filter, settings and input (the plugin's
+// attributes): mcreconChosen, what `auto` ran in each stage (choices_text()), and mcreconNotes,
+// the run's notes (notes_text()).
+void describe_run(std::vector<std::pair<std::string, std::string>>& attributes, const StageTimes& t) {
+  if (!t.choices.empty()) attributes.emplace_back("mcreconChosen", choices_text(t.choices));
+  if (!t.notes.empty()) attributes.emplace_back("mcreconNotes", notes_text(t.notes));
+}
+
 double ms_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -96,9 +104,11 @@ void DenoiseSession::filter_into(Filtered& f, const WriteOptions& write, const E
   f.result = reconstruction_.run_in_place(f.frame, exec, write.keep_components ? &f.components : nullptr);
   f.times.filter_ms = ms_since(t0);
   f.times.notes = reconstruction_.notes();
+  f.times.choices = reconstruction_.choices();
   f.attributes = {{"mcreconFilter", reconstruction_.filter().info().name},
                   {"mcreconParameters", reconstruction_.parameters_text()},
                   {"mcreconInput", input_stamp(f.frame.path)}};  // --resume checks all three
+  describe_run(f.attributes, f.times);
 }
 
 void DenoiseSession::write_filtered(const std::string& output, const Filtered& f, const WriteOptions& write) {
@@ -164,6 +174,7 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   f.attributes = {{"mcreconFilter", filter.info().name},
                   {"mcreconParameters", reconstruction_.parameters_text()},
                   {"mcreconInput", input_stamp(input)}};
+  describe_run(f.attributes, t);
   if (!output.empty()) {
     const auto t1 = std::chrono::steady_clock::now();
     write_filtered(output, f, write);

@@ -17,6 +17,7 @@ namespace mcr {
 struct StageTimes {
   double read_ms = 0, filter_ms = 0, write_ms = 0;
   std::vector<std::string> notes;  // the reconstruction's notes on this frame
+  std::vector<StageChoice> choices;  // filter auto: what it ran in each stage
   double total_ms() const { return read_ms + filter_ms + write_ms; }
 };
 

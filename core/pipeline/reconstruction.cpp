@@ -1,5 +1,6 @@
 #include "pipeline/reconstruction.h"
 
+#include "pipeline/auto_filter.h"
 #include "pipeline/filter_catalog.h"
 #include "util/error.h"
 
@@ -172,6 +173,30 @@ std::vector<std::string> Reconstruction::notes() const {
   if (!light_passes()) all.insert(all.end(), filter().notes().begin(), filter().notes().end());
   all.insert(all.end(), notes_.begin(), notes_.end());
   return all;
+}
+
+std::vector<StageChoice> Reconstruction::choices() const {
+  const std::lock_guard<std::mutex> lock(mutex_);
+  std::vector<StageChoice> c;
+  for (std::size_t i = 0; i < stages_.size(); ++i) {
+    const auto* a = dynamic_cast<const AutoFilter*>(stages_[i]->filter.get());
+    if (!a || a->chosen().empty()) continue;  // not auto, or not run yet
+    c.push_back({light_passes() ? light_stage_name(light_stages()[i]) : "beauty", a->chosen()});
+  }
+  return c;
+}
+
+std::string choices_text(const std::vector<StageChoice>& choices) {
+  if (choices.size() == 1 && choices.front().stage == "beauty") return choices.front().filter;
+  std::string t;
+  for (const StageChoice& c : choices) t += (t.empty() ? "" : "; ") + c.stage + "=" + c.filter;
+  return t;
+}
+
+std::string notes_text(const std::vector<std::string>& notes) {
+  std::string text;
+  for (const std::string& n : notes) text += (text.empty() ? "" : "; ") + n;
+  return text;
 }
 
 std::string Reconstruction::parameters_text() const {

@@ -32,6 +32,20 @@
 
 namespace mcr {
 
+// What filter `auto` ran in one stage of a run: stage "beauty", or with components=light_passes
+// the light stage's name ("diffuse", "glossy direct", ...); filter "input" where it kept the input.
+struct StageChoice {
+  std::string stage, filter;
+};
+
+// "atrous" (the beauty alone), "diffuse=atrous; glossy direct=pwaf; ..." (light stages): the
+// mcreconChosen attribute; empty for none.
+std::string choices_text(const std::vector<StageChoice>& choices);
+
+// The reconstruction's notes (unused settings first) as one line, "; " between them: the
+// mcreconNotes attribute every front end writes.
+std::string notes_text(const std::vector<std::string>& notes);
+
 class Reconstruction {
  public:
   Reconstruction(std::unique_ptr<Filter> filter, bool accumulate);
@@ -61,6 +75,9 @@ class Reconstruction {
   // The unused settings, then the notes of the last run() (the filter's, the accumulation's):
   // a copy, taken under the lock.
   std::vector<std::string> notes() const;
+  // auto's choice in each stage of the last run(), under the lock; empty unless the filter is
+  // auto (the notes say the same in words, with the scores).
+  std::vector<StageChoice> choices() const;
   // "accumulate=true radius=3 ...": every setting, as the mcreconParameters attribute.
   std::string parameters_text() const;
 

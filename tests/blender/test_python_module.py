@@ -111,12 +111,15 @@ def test_auto_reports_its_choice(tmp):
     chosen = [n[len("auto: chose "):].split()[0] for n in t["notes"] if n.startswith("auto: chose ")]
     assert len(chosen) == 1 and any(n.startswith("auto: estimated relMSE") for n in t["notes"]), t["notes"]
     assert chosen[0] in mcrecon.filter_names() and chosen[0] != "auto", t["notes"]
+    assert t["chosen"] == {"beauty": chosen[0]}, t
+    assert mcrecon.denoise_file(ROOM, os.path.join(tmp, "box_py.exr"), "box")["chosen"] is None
     # The same notes as `mcrecon denoise --verbose` prints, and as Session.notes() after a run.
     err = cli("denoise", ROOM, "-o", os.path.join(tmp, "auto_cli.exr"), "-f", "auto", "--verbose", stderr=True)
     prefix = "mcrecon: " + ROOM + ": "
     assert [l[len(prefix):] for l in err.splitlines() if l.startswith(prefix)] == t["notes"], (err, t["notes"])
     s = mcrecon.Session("auto")
     assert s.denoise_file(ROOM, os.path.join(tmp, "auto_session.exr"))["notes"] == s.notes() == t["notes"]
+    assert s.chosen() == t["chosen"], s.chosen()
     want = os.path.join(tmp, "auto_chosen.exr")
     mcrecon.denoise_file(ROOM, want, chosen[0])
     assert np.array_equal(read_channels(out)[1], read_channels(want)[1]), f"auto's output is not {chosen[0]}'s"
@@ -127,6 +130,7 @@ def test_auto_reports_its_choice(tmp):
     got = s.denoise(colour)
     assert got.shape == colour.shape and np.isfinite(got).all()
     assert len([n for n in s.notes() if n.startswith("auto: chose ")]) == 1, s.notes()
+    assert s.chosen() == {"beauty": re.search(r"auto: chose (?:the )?(\S+)", " ".join(s.notes())).group(1)}, s.chosen()
     lacking = [f["name"] for f in mcrecon.filters() if not f["temporal"] and f["name"] != "auto"
                and set(mcrecon.needs(f["name"])["required"]) - {"colour"}]
     skipped = [n for n in s.notes() if n.startswith("auto: candidates skipped: ")]

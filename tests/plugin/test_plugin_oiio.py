@@ -8,7 +8,7 @@ Covered: every non-temporal filter through the `?key=value` name, --iconfig and 
 plugin (-o:fileformatname=mcrecon) on the room sample; temporal filters over an
 `oiiotool --frames 1-16` run on the anim sample (skipped when none is registered); accumulate
 (`mcrecon denoise --accumulate`) over frames 1-4 of the anim sample in all three styles; the
-notes (an unused setting; auto's scores and choice) as the mcreconNotes attribute; no hang on a corrupt EXR; a header
+notes (an unused setting; auto's scores and choice) as the mcreconNotes attribute, auto's choice as mcreconChosen; no hang on a corrupt EXR; a header
 claiming more than its file holds refused before anything opens it;
 --list-formats; errors named as the CLI names them, with a non-zero exit; a read through
 OpenImageIO's Python module.
@@ -416,6 +416,7 @@ class TestNotes(PluginTestBase):
         check_ok(oiiotool(ROOM, "--attrib", "mcrecon:filter", "auto", "-o:fileformatname=mcrecon", out))
         self.assertEqual(header_attribute(out, "mcreconFilter"), "auto")
         self.assertEqual(header_attribute(out, "mcreconNotes"), "; ".join(run))
+        self.assertEqual(header_attribute(out, "mcreconChosen"), chosen[0])  # as the CLI's output says
         assert_same_pixels(self, out, want, "--attrib mcrecon:filter auto (auto chose %s)" % chosen[0])
         # the input plugin: the spec after the first read holds them (the filter runs there)
         read = self.path("read.exr")
@@ -427,6 +428,7 @@ class TestNotes(PluginTestBase):
         try:
             self.assertIsNotNone(inp.read_image(0, 0, 0, 4, "float"), inp.geterror())
             self.assertEqual(inp.spec().getattribute("mcreconNotes"), "; ".join(run))
+            self.assertEqual(inp.spec().getattribute("mcreconChosen"), chosen[0])
         finally:
             inp.close()
 

@@ -13,13 +13,26 @@ import sys
 import tempfile
 import unittest
 
+import json
+
 import numpy as np
+import OpenImageIO as oiio
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import mcrecon_testutil as tu  # noqa: E402
 
 RGBA = ["R", "G", "B", "A"]
 ROOM = os.path.join(tu.source_dir(), "samples", "data", "room", "room_16spp.exr")
+ANIM = os.path.join(tu.source_dir(), "samples", "data", "anim", "anim_1spp_####.exr")
+
+
+def header(path, name):
+    inp = oiio.ImageInput.open(path)
+    assert inp, oiio.geterror()
+    try:
+        return inp.spec().get_string_attribute(name)
+    finally:
+        inp.close()
 
 
 def same_bits(a, b):
@@ -90,6 +103,32 @@ class AutoCliTest(unittest.TestCase):
         tu.run_cli("denoise", ROOM, "-o", want, "-f", chosen)
         self.assertTrue(same_bits(tu.read_channels(out, RGBA), tu.read_channels(want, RGBA)),
                         "auto's output is not `denoise -f %s` of the same file" % chosen)
+
+    def test_json_lines_and_the_header_say_what_auto_ran(self):
+        out = self.path("auto.exr")
+        r = tu.run_cli("denoise", ROOM, "-o", out, "-f", "auto", "--json", "-v")
+        lines = r.stdout.splitlines()
+        self.assertEqual(len(lines), 1, r.stdout)
+        rec = json.loads(lines[0])
+        chosen = chosen_in(r.stderr)  # the note --verbose prints
+        self.assertEqual(rec["chosen"], {"beauty": chosen})
+        self.assertEqual((rec["input"], rec["output"], rec["filter"]), (ROOM, out, "auto"))
+        self.assertIn("auto: chose " + chosen + " with its defaults", rec["notes"])
+        self.assertEqual(set(rec["ms"]), {"read", "filter", "write"})
+        self.assertTrue(all(v >= 0 for v in rec["ms"].values()), rec["ms"])
+        self.assertEqual(header(out, "mcreconChosen"), chosen)
+        self.assertIn("auto: chose " + chosen, header(out, "mcreconNotes"))
+        # The record's choice is the filter that ran: its output bit for bit.
+        want = self.path("chosen.exr")
+        tu.run_cli("denoise", ROOM, "-o", want, "-f", rec["chosen"]["beauty"])
+        self.assertTrue(same_bits(tu.read_channels(out, RGBA), tu.read_channels(want, RGBA)))
+        # Another filter: no choice, in the record or the header; a sequence: a line per frame.
+        seq = self.path("box_####.exr")
+        r = tu.run_cli("denoise", ANIM, "--frames", "1-2", "-o", seq, "-f", "box", "--json")
+        recs = [json.loads(l) for l in r.stdout.splitlines()]
+        self.assertEqual([(x["input"][-8:], x["output"][-8:], x["chosen"]) for x in recs],
+                         [("0001.exr", "0001.exr", None), ("0002.exr", "0002.exr", None)])
+        self.assertEqual(header(self.path("box_0001.exr"), "mcreconChosen"), "")
 
     def test_denoise_auto_on_colour_only_files(self):
         h, w = 64, 80
