@@ -4,7 +4,7 @@ import os
 
 import bpy
 
-from . import changes, native, output_paths, pass_output, properties
+from . import changes, native, output_paths, pass_output, properties, status
 
 
 _ITEMS = []  # Blender needs the strings of dynamic enum items kept alive
@@ -108,7 +108,8 @@ class MCRECON_OT_denoise_files(bpy.types.Operator):
         self._done += 1
         self._last = frame
         context.window_manager.progress_update(self._done)
-        print(f"mcrecon: [{self._done}/{len(self._jobs)}] {out} ({t['total_ms']:.0f} ms)", flush=True)
+        print(f"mcrecon: [{self._done}/{len(self._jobs)}] {out} ({status.filter_text(self._session.filter, t)}, "
+              f"{t['total_ms']:.0f} ms)", flush=True)
         if len(self._jobs) == 1:
             for note in t["notes"]:  # auto: its scores and choice
                 self.report({"INFO"}, f"mcrecon: {note}")

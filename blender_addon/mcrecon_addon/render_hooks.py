@@ -231,8 +231,9 @@ def denoise_render(scene, source, out, render_path):
             t = session.denoise_file(source, out, layer=layer, keep_components=scene.mcrecon.keep_components,
                                      display=display)
         _job["next"] = frame + 1
-        status.show(f"mcrecon: frame {frame} denoised in {t['total_ms'] / 1000:.1f} s ({session.filter})")
-        log(scene, f"{session.filter}{' (accumulated)' if session.accumulate else ''} frame {frame}: {out} "
+        what = status.filter_text(session.filter, t)  # auto: what it ran
+        status.show(f"mcrecon: frame {frame} denoised in {t['total_ms'] / 1000:.1f} s ({what})")
+        log(scene, f"{what}{' (accumulated)' if session.accumulate else ''} frame {frame}: {out} "
                    f"({t['filter_ms']:.0f} ms filter, {t['total_ms']:.0f} ms total)")
         for note in session.notes():
             log(scene, note)

@@ -34,3 +34,15 @@ def _tick():
         _state["timer"] = False
         return None  # nothing left to show: the timer ends
     return 0.2
+
+
+def filter_text(name, times):
+    """'atrous', or for auto what it ran: 'auto: atrous', 'auto: kept the input', 'auto: diffuse
+    atrous, glossy direct pwaf' (times: what denoise_file returned)."""
+    chosen = times.get("chosen")
+    if not chosen:
+        return name
+    if list(chosen) == ["beauty"]:
+        c = chosen["beauty"]
+        return f"{name}: " + ("kept the input" if c == "input" else c)
+    return f"{name}: " + ", ".join(f"{stage} {c}" for stage, c in chosen.items())

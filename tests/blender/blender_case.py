@@ -121,6 +121,9 @@ def check_render(filter_name, box_radius=None):
     if filter_name == "auto":  # its report reaches the console, naming a filter it ran
         chose = re.findall(r"mcrecon: auto: chose (?:the )?(\S+)", log)
         assert len(chose) == 1 and chose[0] in mcrecon.filter_names() + ["input"], log[-3000:]
+        # ... and the frame's line (the status bar's text too) names it
+        shown = "kept the input" if chose[0] == "input" else chose[0]
+        assert re.search(r"mcrecon: auto: %s frame \d+: " % re.escape(shown), log), log[-3000:]
         print(f"auto chose {chose[0]}")
     e_noisy, e_den = relmse(rgb(noisy), rgb(ref)), relmse(rgb(den), rgb(ref))
     print(f"{filter_name}: relMSE noisy {e_noisy:.5f}, denoised {e_den:.5f} "
