@@ -24,6 +24,9 @@ constexpr double kProbe = 0.01;    // Monte Carlo probe: eps = kProbe x the robu
 // Without a variance pass, pixel (x, y) is held out where (x + 2y + phase) % kMaskPeriod == 0,
 // one in five, none of whose four axis neighbours is held out (two patterns ranked no better).
 constexpr int kMaskPeriod = 5;
+// Held out, an ordinary pixel's noise variance is at most this many times its 3x3 neighbourhood's
+// squared range (hold_out()): a deviation 4x the range of nine samples is not noise.
+constexpr double kRangeCap = 16.0;
 // Far-out pixels rarer than this share of the held-out ones leave "converged" to the rest.
 constexpr double kRareFarOut = 0.001;
 
@@ -159,11 +162,14 @@ double neighbourhood_range(const Image& y, const NoiseScales& ns, int x, int yy,
 // mean: a filter's result there then does not depend on the pixel's own noise. The feature
 // passes stay (they carry the edges the filters follow, and little of the noise). s.held: those
 // pixels, each with its weights and the input's estimated error: held out, an ordinary pixel's
-// noise variance is taken at most as its 3x3 neighbourhood's squared range. The window estimate
-// (noise_scale.h) spreads a bright highlight's edges over 9x9 pixels: on the glossy reference
-// ten pixels beside a sun's reflection (93 against 0.06 around them) made 96% of the input's
-// estimate, relMSE 0.35 for a 2048-spp render, and gaussian was run on it. Noise of variance
-// v spreads nine pixels over about 3 sqrt(v), so the cap leaves noise its variance.
+// noise variance is taken at most as kRangeCap times its 3x3 neighbourhood's squared range. The
+// window estimate (noise_scale.h) spreads a bright highlight's edges over 9x9 pixels: on the
+// glossy reference ten pixels beside a sun's reflection (93 against 0.06 around them) made 96%
+// of the input's estimate, relMSE 0.35 for a 2048-spp render, and gaussian was run on it. Noise
+// of deviation s spreads nine pixels over about 3 s, so the cap leaves noise its variance; a
+// tight one (1x) cut it where the noise is heavy-tailed too (the flattened dof scene: 0.82x its
+// true error against 0.89x at 16x), which sides with the input twice over (its own estimate,
+// and the check's (f_J - y)^2 - e).
 void hold_out(Sample& s, int phase) {
   s.masked = s.frame;
   Pass& colour = const_cast<Pass&>(s.masked.get(Role::Colour));  // the pass the filters read as colour
@@ -181,7 +187,7 @@ void hold_out(Sample& s, int phase) {
         h.e[c] = input_error(s, i, c, y.pixel(x, yy));
         if (!h.far) {
           const double r = neighbourhood_range(y, s.noise, x, yy, c);
-          h.e[c] = std::min(h.e[c], r * r);
+          h.e[c] = std::min(h.e[c], kRangeCap * r * r);
         }
       }
       s.held.push_back(h);

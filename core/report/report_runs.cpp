@@ -86,6 +86,20 @@ const std::vector<Frame>* frames_for(const LoadedReportScene& s, Filter& filter,
   return frames;
 }
 
+std::string choices_summary(const std::vector<std::string>& per_frame) {
+  std::vector<std::pair<std::string, int>> counts;  // in the order they came
+  for (const std::string& c : per_frame) {
+    auto it = std::find_if(counts.begin(), counts.end(), [&](const auto& p) { return p.first == c; });
+    if (it == counts.end()) counts.emplace_back(c, 1);
+    else ++it->second;
+  }
+  if (counts.size() == 1) return counts.front().first;
+  std::stable_sort(counts.begin(), counts.end(), [](const auto& x, const auto& y) { return x.second > y.second; });
+  std::string t;
+  for (const auto& [name, n] : counts) t += (t.empty() ? "" : ", ") + name + " x" + std::to_string(n);
+  return t;
+}
+
 RunResult run_in_process(const LoadedReportScene& s, Filter& filter, const std::vector<Frame>& frames, int nthreads) {
   RunResult r;
   r.filter = filter.info().name;
@@ -95,10 +109,13 @@ RunResult run_in_process(const LoadedReportScene& s, Filter& filter, const std::
   const bool peak = reset_peak_resident();
   const double before = resident_mb();
   double seconds = 0;
+  const auto* a = dynamic_cast<const AutoFilter*>(&filter);
+  std::vector<std::string> chosen;  // auto's, per frame
   for (const Frame& f : frames) {
     const auto t0 = std::chrono::steady_clock::now();
     r.outputs.push_back(filter.execute(f, exec));
     seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (a) chosen.push_back(a->chosen());
   }
   // The outputs are kept for scoring: subtract them, they are not the filter's working memory.
   double kept = 0;
@@ -107,9 +124,9 @@ RunResult run_in_process(const LoadedReportScene& s, Filter& filter, const std::
   r.seconds = r.filter_seconds = seconds;
   r.scores = score_outputs(r.outputs, s.references, nthreads);
   for (const std::string& n : filter.notes()) r.notes.push_back(n);
-  if (const auto* a = dynamic_cast<const AutoFilter*>(&filter)) {
+  if (a) {
     r.kind = "auto";
-    r.chosen = a->chosen();
+    r.chosen = choices_summary(chosen);
   }
   return r;
 }
@@ -129,9 +146,11 @@ double parse_filter_ms(const std::string& log) {
 }
 
 // The notes `mcrecon denoise --verbose` printed ("mcrecon: FILE: note"; not its timing lines),
-// once each, and auto's choice from "auto: chose X with ..." / "auto: chose the input ...".
+// once each, and auto's choice from each frame's "auto: chose X with ..." / "auto: chose the
+// input ..." (choices_summary()).
 void take_notes(const std::string& log, RunResult& r) {
   std::istringstream in(log);
+  std::vector<std::string> chosen;
   for (std::string line; std::getline(in, line);) {
     if (line.rfind("mcrecon: ", 0) != 0) continue;
     const std::size_t colon = line.find(": ", 9);
@@ -139,9 +158,10 @@ void take_notes(const std::string& log, RunResult& r) {
     const std::string note = line.substr(colon + 2);
     if (note.rfind("read ", 0) == 0) continue;  // "read 24 ms, filter 12 ms, ..."
     if (std::find(r.notes.begin(), r.notes.end(), note) == r.notes.end() && r.notes.size() < 40) r.notes.push_back(note);
-    if (note.rfind("auto: chose the input", 0) == 0) r.chosen = "input";
-    else if (note.rfind("auto: chose ", 0) == 0) r.chosen = note.substr(12, note.find(' ', 12) - 12);
+    if (note.rfind("auto: chose the input", 0) == 0) chosen.push_back("input");
+    else if (note.rfind("auto: chose ", 0) == 0) chosen.push_back(note.substr(12, note.find(' ', 12) - 12));
   }
+  r.chosen = choices_summary(chosen);
 }
 
 void fail(RunResult& r, const std::string& what, const CommandRun& run, const std::string& log) {

@@ -36,7 +36,7 @@ struct RunResult {
   double sweep_value = 0;
   double seconds = -1, filter_seconds = -1, peak_memory_mb = -1;
   Scores scores;
-  std::string chosen;               // auto: the filter it ran ("input" when it kept the input)
+  std::string chosen;               // auto: the filter it ran ("input" when it kept the input), choices_summary()
   std::vector<std::string> notes;
   std::string error;                // a peer or command that failed: why
   std::vector<Image> outputs;       // per frame
@@ -44,6 +44,10 @@ struct RunResult {
   bool pareto_relmse = false, pareto_ssim = false;
   bool ok() const { return error.empty(); }
 };
+
+// auto's choices over the frames of a run: "pwaf" when every frame ran the same, else each with
+// its frame count, most first (ties in the order they came): "pwaf x8, bilateral x4, atrous x1".
+std::string choices_summary(const std::vector<std::string>& per_frame);
 
 // The frames a filter takes in this scene (flat or deep), or null with `why` set.
 const std::vector<Frame>* frames_for(const LoadedReportScene& s, Filter& filter, std::string& why);

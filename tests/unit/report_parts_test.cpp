@@ -15,12 +15,22 @@
 #include "image/deep.h"
 #include "report/peer_command.h"
 #include "report/report_images.h"
+#include "report/report_runs.h"
 #include "report/scaling.h"
 
 namespace mcr {
 
 namespace fs = std::filesystem;
 using testutil::expect_error;
+
+// A sequence's frames may each run another filter under auto: the report says so, with counts.
+TEST(ReportRuns, AutosChoicesOverFramesAreCounted) {
+  EXPECT_EQ(choices_summary({"pwaf"}), "pwaf");
+  EXPECT_EQ(choices_summary({"input", "input"}), "input");
+  EXPECT_EQ(choices_summary({"atrous", "pwaf", "pwaf", "box", "pwaf", "atrous"}), "pwaf x3, atrous x2, box x1");
+  EXPECT_EQ(choices_summary({"box", "pwaf"}), "box x1, pwaf x1");  // ties: in the order they came
+  EXPECT_EQ(choices_summary({}), "");
+}
 
 TEST(ReportImages, ErrorMapIsTheRelMseTermPerPixel) {
   Image ref(3, 2, 3, 0.5f), img(3, 2, 3, 0.5f);
