@@ -10,13 +10,16 @@ file; --keep-components without light passes is refused.
 
 Run by ctest as `/usr/bin/python3 tests/python/test_cli_components.py` with MCRECON_BIN.
 """
+import json
 import os
+import re
 import shutil
 import sys
 import tempfile
 import unittest
 
 import numpy as np
+import OpenImageIO as oiio
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import light_passes_testutil as lp  # noqa: E402
@@ -115,10 +118,19 @@ class ComponentsCliTest(unittest.TestCase):
             self.assertIn("components", [p["name"] for p in f["parameters"]], f["name"])
         out = self.path("auto.exr")
         proc = self.denoise("-f", "auto", "--set", "components=light_passes", "--keep-components", self.input,
-                            "-o", out, "-v")
+                            "-o", out, "-v", "--json")
         self.assertIn("diffuse: auto:", proc.stderr)
         self.assertIn("glossy direct: auto:", proc.stderr)
         self.assertIn("transmission indirect: auto:", proc.stderr)
+        # What auto ran in each light stage: the --json record and the header say what the notes say.
+        said = dict(re.findall(r": ([a-z ]+): auto: chose (?:the )?(\S+)", proc.stderr))
+        stages = ["diffuse", "glossy direct", "glossy indirect", "transmission direct", "transmission indirect"]
+        self.assertEqual(sorted(said), sorted(stages), proc.stderr)
+        self.assertEqual(json.loads(proc.stdout)["chosen"], said)
+        inp = oiio.ImageInput.open(out)
+        self.assertEqual(inp.spec().get_string_attribute("mcreconChosen"),
+                         "; ".join("%s=%s" % (s, said[s]) for s in stages))
+        inp.close()
 
 
 if __name__ == "__main__":
