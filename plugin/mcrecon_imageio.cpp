@@ -139,16 +139,6 @@ Filtered run_filter(const mp::Request& r, const std::string& settings, const std
   }
 }
 
-// What the output's header says of the run: filter, every setting, what auto chose and the
-// notes (when any).
-std::vector<std::pair<std::string, std::string>> description(const std::string& filter, const std::string& params,
-                                                             const std::string& notes, const std::string& chosen) {
-  std::vector<std::pair<std::string, std::string>> d = {{"mcreconFilter", filter}, {"mcreconParameters", params}};
-  if (!chosen.empty()) d.emplace_back("mcreconChosen", chosen);
-  if (!notes.empty()) d.emplace_back("mcreconNotes", notes);
-  return d;
-}
-
 // ---------------------------------------------------------------------------
 
 class McreconInput final : public ImageInput {
@@ -201,7 +191,7 @@ class McreconInput final : public ImageInput {
     m_spec.alpha_channel = 3;
     m_spec.attribute("Software", "mcrecon");
     if (deferred_error_.empty()) {
-      for (const auto& [name, value] : description(request_.filter, params_text, notes, chosen)) m_spec.attribute(name, value);
+      for (const auto& [name, value] : mcr::run_attributes(request_.filter, params_text, chosen, notes)) m_spec.attribute(name, value);
       m_spec.attribute("mcreconSource", request_.source);
     } else {
       m_spec.attribute("mcreconError", deferred_error_);
@@ -402,7 +392,7 @@ class McreconOutput final : public ImageOutput {
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;
       wo.compression = request_.compression;
-      wo.attributes = description(request_.filter, params_text_, filtered.notes, filtered.chosen);
+      wo.attributes = mcr::run_attributes(request_.filter, params_text_, filtered.chosen, filtered.notes);
       for (const mcr::ComponentImage& c : filtered.components)
         wo.layers.emplace_back(mcr::component_layer_prefix(frame.layer) + c.name, &c.rgb);
       mcr::write_result(name_, filtered.rgb, frame, wo);

@@ -15,9 +15,12 @@
 //       five, replaced by their neighbours' mean in the second run, after Batson & Royer
 //       2019), each candidate scored by
 //       (f - y)^2 - e + 2 (f - f_J)(y - y_J): SURE's E n f taken from the pixel's own
-//       excursion and the filter's response to it instead of a derivative (.cpp).
+//       excursion and the filter's response to it instead of a derivative; e, the input's
+//       error there, its noise variance (at most 16x its 3x3 range squared) or a far-out
+//       pixel's squared distance to its median (.cpp).
 //  3. Run the best on the whole region, or copy the input when its own estimated relMSE
-//     is below `converged` or the best is not estimated to cut it by min_gain: with a
+//     is below `converged` (held out, without far-out pixels where they are under 1 in
+//     1000: a converged render's rare glints) or the best is not estimated to cut it by min_gain: with a
 //     variance pass by its SURE score, without by a blind-spot check, its result at the
 //     held-out pixels made from their neighbours alone (errs toward keeping a clean
 //     render's detail).

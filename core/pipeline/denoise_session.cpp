@@ -39,12 +39,13 @@ void keep_freed_memory() {
 #endif
 }
 
-// What the output's header says of the run besides filter, settings and input (the plugin's
-// attributes): mcreconChosen, what `auto` ran in each stage (choices_text()), and mcreconNotes,
-// the run's notes (notes_text()).
-void describe_run(std::vector<std::pair<std::string, std::string>>& attributes, const StageTimes& t) {
-  if (!t.choices.empty()) attributes.emplace_back("mcreconChosen", choices_text(t.choices));
-  if (!t.notes.empty()) attributes.emplace_back("mcreconNotes", notes_text(t.notes));
+// What the output's header says of the run (run_attributes(), as the plugin writes it) and
+// mcreconInput: --resume checks mcreconFilter, mcreconParameters and mcreconInput.
+std::vector<std::pair<std::string, std::string>> describe_run(const std::string& filter, const std::string& params,
+                                                              const std::string& input, const StageTimes& t) {
+  auto a = run_attributes(filter, params, choices_text(t.choices), notes_text(t.notes));
+  a.emplace_back("mcreconInput", input_stamp(input));
+  return a;
 }
 
 double ms_since(std::chrono::steady_clock::time_point t0) {
@@ -105,10 +106,7 @@ void DenoiseSession::filter_into(Filtered& f, const WriteOptions& write, const E
   f.times.filter_ms = ms_since(t0);
   f.times.notes = reconstruction_.notes();
   f.times.choices = reconstruction_.choices();
-  f.attributes = {{"mcreconFilter", reconstruction_.filter().info().name},
-                  {"mcreconParameters", reconstruction_.parameters_text()},
-                  {"mcreconInput", input_stamp(f.frame.path)}};  // --resume checks all three
-  describe_run(f.attributes, f.times);
+  f.attributes = describe_run(reconstruction_.filter().info().name, reconstruction_.parameters_text(), f.frame.path, f.times);
 }
 
 void DenoiseSession::write_filtered(const std::string& output, const Filtered& f, const WriteOptions& write) {
@@ -171,10 +169,7 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   t.read_ms = source.read_ms();  // the bands' reads, interleaved with filtering
   t.filter_ms = ms_since(t0) - t.read_ms;
   t.notes = std::move(notes);
-  f.attributes = {{"mcreconFilter", filter.info().name},
-                  {"mcreconParameters", reconstruction_.parameters_text()},
-                  {"mcreconInput", input_stamp(input)}};
-  describe_run(f.attributes, t);
+  f.attributes = describe_run(filter.info().name, reconstruction_.parameters_text(), input, t);
   if (!output.empty()) {
     const auto t1 = std::chrono::steady_clock::now();
     write_filtered(output, f, write);

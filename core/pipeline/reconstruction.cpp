@@ -199,6 +199,14 @@ std::string notes_text(const std::vector<std::string>& notes) {
   return text;
 }
 
+std::vector<std::pair<std::string, std::string>> run_attributes(const std::string& filter, const std::string& params,
+                                                                const std::string& chosen, const std::string& notes) {
+  std::vector<std::pair<std::string, std::string>> a = {{"mcreconFilter", filter}, {"mcreconParameters", params}};
+  if (!chosen.empty()) a.emplace_back("mcreconChosen", chosen);
+  if (!notes.empty()) a.emplace_back("mcreconNotes", notes);
+  return a;
+}
+
 std::string Reconstruction::parameters_text() const {
   const std::string own = mcr::parameters_text(filter());
   return accumulate_ ? "accumulate=true " + own : own;

@@ -46,6 +46,12 @@ std::string choices_text(const std::vector<StageChoice>& choices);
 // mcreconNotes attribute every front end writes.
 std::string notes_text(const std::vector<std::string>& notes);
 
+// What an output's header says of the run, as every front end writes it: mcreconFilter,
+// mcreconParameters (parameters_text()), then mcreconChosen (choices_text()) and mcreconNotes
+// (notes_text()) when not empty.
+std::vector<std::pair<std::string, std::string>> run_attributes(const std::string& filter, const std::string& params,
+                                                                const std::string& chosen, const std::string& notes);
+
 class Reconstruction {
  public:
   Reconstruction(std::unique_ptr<Filter> filter, bool accumulate);
