@@ -44,11 +44,18 @@ nlohmann::json deep_report(const DeepSamples& d) {
 nlohmann::json lightfield_report(const LightField& lf) {
   const std::size_t repaired = lf.nonfinite_replaced;
   const LightFieldSummary s = summarize(lf);
-  return {{"effect", effect_name(lf.effect)}, {"l", lf.l}, {"spp", lf.spp()}, {"y_range", lf.y_range},
+  nlohmann::json j = {{"effect", lightfield_kind(lf)}, {"l", lf.l}, {"spp", lf.spp()}, {"y_range", lf.y_range},
           {"sigma_y", lf.sigma_y}, {"slope_min", s.slope_min}, {"slope_max", s.slope_max},
           {"pixels", lf.pixels()}, {"nothing_to_shear", s.nothing_to_shear}, {"opposite_slope_signs", s.opposite_signs},
           {"converged", s.converged}, {"axis1_pixels_per_unit", s.e1_mean}, {"axis2_pixels_per_unit", s.e2_mean},
           {"geometry", lf.has_geometry()}, {"nonfinite_values_replaced", repaired}};
+  if (lf.combined()) {
+    // The lens half (soft shadows through a lens): its bounds, the pixels in focus.
+    const LightFieldSummary u = summarize(*lf.lens);
+    j["lens"] = {{"u_range", lf.lens->y_range}, {"sigma_u", lf.lens->sigma_y}, {"slope_min", u.slope_min},
+                 {"slope_max", u.slope_max}, {"in_focus", u.nothing_to_shear}, {"opposite_slope_signs", u.opposite_signs}};
+  }
+  return j;
 }
 
 struct InfoArgs {
@@ -134,6 +141,13 @@ int run_info(const InfoArgs& a) {
               << ", converged " << l["converged"].get<std::size_t>() << "\n  axes: " << l["axis1_pixels_per_unit"].get<float>()
               << " and " << l["axis2_pixels_per_unit"].get<float>() << " pixels per x unit (mean); geometry (P, N): "
               << (l["geometry"].get<bool>() ? "yes" : "no") << "\n";
+    if (l.contains("lens")) {
+      const auto& u = l["lens"];
+      std::cout << "  lens: u in [-" << u["u_range"].get<float>() << ", " << u["u_range"].get<float>() << "]^2, sigma_u "
+                << u["sigma_u"].get<float>() << "; lens slopes " << u["slope_min"].get<float>() << " .. "
+                << u["slope_max"].get<float>() << "; in focus " << u["in_focus"].get<std::size_t>()
+                << ", slopes of both signs " << u["opposite_slope_signs"].get<std::size_t>() << "\n";
+    }
   }
   std::cout << "layers:";
   for (const auto& l : frame.layers) std::cout << " " << (l.empty() ? "(top level)" : l);

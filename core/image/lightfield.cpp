@@ -9,6 +9,10 @@
 
 namespace mcr {
 
+namespace {
+const char* const kCombined = "soft_shadows+dof";
+}  // namespace
+
 const char* effect_name(LightFieldEffect e) {
   switch (e) {
     case LightFieldEffect::SoftShadows: return "soft_shadows";
@@ -28,6 +32,10 @@ void LightField::resize(int w, int h, int l_, bool geometry) {
   for (auto* v : {&px, &py, &pz, &nx, &ny, &nz, &w1x, &w1y, &w1z, &w2x, &w2y, &w2z}) v->assign(geometry ? p : 0, 0.f);
 }
 
+std::string lightfield_kind(const LightField& lf) {
+  return lf.combined() ? std::string(kCombined) : std::string(effect_name(lf.effect));
+}
+
 bool is_lightfield(const DeepSamples& deep) { return deep.attributes.count("mcrecon:lightfield") != 0; }
 
 float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range, float y) {
@@ -36,8 +44,9 @@ float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range,
 }
 
 float lightfield_sample_weight(const LightField& lf, std::size_t k) {
-  return lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[k]) *
-         lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[k]);
+  const float w = lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y1[k]) *
+                  lightfield_y_weight(lf.effect, lf.sigma_y, lf.y_range, lf.y2[k]);
+  return lf.combined() ? w * lightfield_sample_weight(*lf.lens, k) : w;
 }
 
 namespace {
@@ -47,6 +56,8 @@ const char* const kPixelChannels[] = {"lf.smin", "lf.smax", "lf.e1x", "lf.e1y", 
 const char* const kGeometryChannels[] = {"P.X", "P.Y", "P.Z", "N.X", "N.Y", "N.Z"};
 const char* const kAxisChannels[] = {"lf.w1x", "lf.w1y", "lf.w1z", "lf.w2x", "lf.w2y", "lf.w2z"};
 const char* const kModChannels[] = {"lf.modR", "lf.modG", "lf.modB"};
+const char* const kLensSampleChannels[] = {"lf.kR", "lf.kG", "lf.kB", "lf.u1", "lf.u2"};
+const char* const kLensPixelChannels[] = {"lf.dmin", "lf.dmax"};
 
 std::string at(int x, int y) { return "pixel (" + std::to_string(x) + ", " + std::to_string(y) + ")"; }
 
@@ -71,12 +82,14 @@ double number(const DeepSamples& deep, const std::string& name, const std::strin
   return v;
 }
 
-LightFieldEffect parse_effect(const DeepSamples& deep, const std::string& path) {
+LightFieldEffect parse_effect(const DeepSamples& deep, const std::string& path, bool* combined) {
   const std::string& e = attribute(deep, "mcrecon:lightfield", path);
+  *combined = e == kCombined;
+  if (*combined) return LightFieldEffect::SoftShadows;
   for (LightFieldEffect k : {LightFieldEffect::SoftShadows, LightFieldEffect::Dof, LightFieldEffect::Gi})
     if (e == effect_name(k)) return k;
-  throw Error(Errc::ReadFailed, "'" + path + "': mcrecon:lightfield = '" + e +
-                                    "' is not an effect (soft_shadows, dof, gi)");
+  throw Error(Errc::ReadFailed, "'" + path + "': mcrecon:lightfield = '" + e + "' is not an effect (soft_shadows, dof, gi, " +
+                                    kCombined + ")");
 }
 
 int require_channel(const DeepSamples& deep, const char* name, const std::string& path, const char* what) {
@@ -89,17 +102,93 @@ int require_channel(const DeepSamples& deep, const char* name, const std::string
 
 const char* channel_meaning(const std::string& name) {
   if (name == "lf.y1" || name == "lf.y2") return "the sample's coordinate on the light, lens or v-plane";
+  if (name == "lf.u1" || name == "lf.u2") return "the sample's coordinate on the lens";
+  if (name == "lf.kR" || name == "lf.kG" || name == "lf.kB") return "the texture at the sample's hit";
   if (name == "lf.smin" || name == "lf.smax") return "the pixel's slope bounds";
+  if (name == "lf.dmin" || name == "lf.dmax") return "the pixel's lens slope bounds";
   if (name.rfind("lf.e", 0) == 0) return "the screen axes of the pixel's filter";
   if (name == "Z") return "the receiver's depth";
   return "the sample's value";
+}
+
+// Channel c's l*l values of the pixel at s0 into dst[p*spp ..]: a non-finite one takes the
+// pixel's finite mean (0 if none), counted in repaired.
+void read_values(const DeepSamples& deep, int c, std::uint64_t s0, std::size_t p, std::uint64_t spp,
+                 std::vector<float>& dst, std::size_t& repaired) {
+  double sum = 0;
+  std::uint64_t n = 0;
+  for (std::uint64_t k = 0; k < spp; ++k) {
+    const float v = deep.values[c][s0 + k];
+    if (std::isfinite(v)) sum += v, ++n;
+  }
+  const float mean = n ? float(sum / double(n)) : 0.f;
+  for (std::uint64_t k = 0; k < spp; ++k) {
+    const float v = deep.values[c][s0 + k];
+    dst[p * spp + k] = std::isfinite(v) ? v : (++repaired, mean);
+  }
+}
+
+// Channels a, b: the pixel's l*l coordinates into y1, y2, refused when non-finite or beyond range.
+void read_coordinates(const DeepSamples& deep, int a, int b, std::uint64_t s0, std::size_t p, std::uint64_t spp,
+                      float range, const char* names, const char* attr, const std::string& path, int x, int y,
+                      std::vector<float>& y1, std::vector<float>& y2) {
+  const float lim = range * (1 + 1e-4f);
+  for (std::uint64_t k = 0; k < spp; ++k) {
+    const float u = deep.values[a][s0 + k], v = deep.values[b][s0 + k];
+    if (!std::isfinite(u) || !std::isfinite(v) || std::fabs(u) > lim || std::fabs(v) > lim) {
+      std::ostringstream os;
+      os << "'" << path << "': " << at(x, y) << " sample " << k << " has coordinate (" << names << ") = (" << u << ", "
+         << v << "), outside [-" << range << ", " << range << "] (" << attr << ")";
+      throw Error(Errc::ReadFailed, os.str());
+    }
+    y1[p * spp + k] = u;
+    y2[p * spp + k] = v;
+  }
+}
+
+// The lens half of a combined light field (LightField::lens), its samples in lf's order.
+std::shared_ptr<const LightField> decode_lens(const DeepSamples& deep, const LightField& lf, const std::string& path,
+                                              std::size_t& repaired) {
+  auto lens = std::make_shared<LightField>();
+  LightField& d = *lens;
+  d.effect = LightFieldEffect::Dof;
+  d.resize(lf.width, lf.height, lf.l, false);
+  d.y_range = float(number(deep, "mcrecon:lf_u_range", path, 1e-6, 1e6));
+  d.sigma_y = float(number(deep, "mcrecon:lf_sigma_u", path, 1e-6, 1e6));
+  int sc[5], pc[2];
+  for (int i = 0; i < 5; ++i) sc[i] = require_channel(deep, kLensSampleChannels[i], path, channel_meaning(kLensSampleChannels[i]));
+  for (int i = 0; i < 2; ++i) pc[i] = require_channel(deep, kLensPixelChannels[i], path, channel_meaning(kLensPixelChannels[i]));
+  const std::uint64_t spp = std::uint64_t(lf.spp());
+  for (int y = 0; y < deep.height; ++y)
+    for (int x = 0; x < deep.width; ++x) {
+      const std::size_t p = std::size_t(y) * deep.width + x;
+      const std::uint64_t s0 = deep.first(x, y);
+      read_coordinates(deep, sc[3], sc[4], s0, p, spp, d.y_range, "lf.u1, lf.u2", "mcrecon:lf_u_range", path, x, y, d.y1, d.y2);
+      read_values(deep, sc[0], s0, p, spp, d.r, repaired);
+      read_values(deep, sc[1], s0, p, spp, d.g, repaired);
+      read_values(deep, sc[2], s0, p, spp, d.b, repaired);
+      const float lo = deep.values[pc[0]][s0], hi = deep.values[pc[1]][s0];
+      if (!std::isfinite(lo) || !std::isfinite(hi) || lo > hi) {
+        std::ostringstream os;
+        os << "'" << path << "': " << at(x, y) << " has lens slope bounds lf.dmin = " << lo << ", lf.dmax = " << hi
+           << " (finite, dmin <= dmax)";
+        throw Error(Errc::ReadFailed, os.str());
+      }
+      d.smin[p] = lo;
+      d.smax[p] = hi;
+      d.e1x[p] = 1;
+      d.e2y[p] = 1;
+      d.depth[p] = lf.depth[p];
+    }
+  return lens;
 }
 
 }  // namespace
 
 LightField decode_lightfield(const DeepSamples& deep, const std::string& path, std::size_t* nonfinite_values) {
   LightField lf;
-  lf.effect = parse_effect(deep, path);
+  bool combined = false;
+  lf.effect = parse_effect(deep, path, &combined);
   const int l = int(number(deep, "mcrecon:lf_l", path, 1, 64));
   if (double(l) != number(deep, "mcrecon:lf_l", path, 1, 64))
     throw Error(Errc::ReadFailed, "'" + path + "': mcrecon:lf_l = '" + attribute(deep, "mcrecon:lf_l", path) +
@@ -143,7 +232,6 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
     for (auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) v->clear();
 
   std::size_t repaired = 0;
-  const float ylim = lf.y_range * (1 + 1e-4f);
   std::vector<float*> pixel_dst = {lf.smin.data(), lf.smax.data(), lf.e1x.data(), lf.e1y.data(),
                                    lf.e2x.data(),  lf.e2y.data(),  lf.depth.data()};
   std::vector<float*> geo_dst = {lf.px.data(), lf.py.data(), lf.pz.data(), lf.nx.data(), lf.ny.data(), lf.nz.data()};
@@ -152,32 +240,12 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
       const std::size_t p = std::size_t(y) * deep.width + x;
       const std::uint64_t s0 = deep.first(x, y);
       // Coordinates: a sample without a place on the light cannot be filtered; refused.
-      for (std::uint64_t k = 0; k < spp; ++k) {
-        const float a = deep.values[sc[3]][s0 + k], c = deep.values[sc[4]][s0 + k];
-        if (!std::isfinite(a) || !std::isfinite(c) || std::fabs(a) > ylim || std::fabs(c) > ylim) {
-          std::ostringstream os;
-          os << "'" << path << "': " << at(x, y) << " sample " << k << " has coordinate (lf.y1, lf.y2) = (" << a << ", "
-             << c << "), outside [-" << lf.y_range << ", " << lf.y_range << "] (mcrecon:lf_y_range)";
-          throw Error(Errc::ReadFailed, os.str());
-        }
-        lf.y1[p * spp + k] = a;
-        lf.y2[p * spp + k] = c;
-      }
+      read_coordinates(deep, sc[3], sc[4], s0, p, spp, lf.y_range, "lf.y1, lf.y2", "mcrecon:lf_y_range", path, x, y,
+                       lf.y1, lf.y2);
       // Values: a non-finite one takes its pixel's finite mean (0 if none), counted.
-      for (int ch = 0; ch < 3; ++ch) {
-        std::vector<float>& dst = ch == 0 ? lf.r : ch == 1 ? lf.g : lf.b;
-        double sum = 0;
-        std::uint64_t n = 0;
-        for (std::uint64_t k = 0; k < spp; ++k) {
-          const float v = deep.values[sc[ch]][s0 + k];
-          if (std::isfinite(v)) sum += v, ++n;
-        }
-        const float mean = n ? float(sum / double(n)) : 0.f;
-        for (std::uint64_t k = 0; k < spp; ++k) {
-          const float v = deep.values[sc[ch]][s0 + k];
-          dst[p * spp + k] = std::isfinite(v) ? v : (++repaired, mean);
-        }
-      }
+      read_values(deep, sc[0], s0, p, spp, lf.r, repaired);
+      read_values(deep, sc[1], s0, p, spp, lf.g, repaired);
+      read_values(deep, sc[2], s0, p, spp, lf.b, repaired);
       // Per-pixel values are the first sample's; slopes and axes must be finite.
       for (int i = 0; i < 7; ++i) {
         const float v = deep.values[pc[i]][s0];
@@ -226,6 +294,7 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
         }
       }
     }
+  if (combined) lf.lens = decode_lens(deep, lf, path, repaired);
   lf.nonfinite_replaced = repaired;
   if (nonfinite_values) *nonfinite_values = repaired;
   return lf;
@@ -276,6 +345,10 @@ DeepSamples encode_lightfield(const LightField& lf) {
     for (const char* c : kAxisChannels) d.channel_names.push_back(c);
   if (lf.has_modulation())
     for (const char* c : kModChannels) d.channel_names.push_back(c);
+  if (lf.combined()) {
+    for (const char* c : kLensSampleChannels) d.channel_names.push_back(c);
+    for (const char* c : kLensPixelChannels) d.channel_names.push_back(c);
+  }
   d.values.reserve(d.channel_names.size());
   for (const auto* v : {&lf.r, &lf.g, &lf.b, &lf.y1, &lf.y2}) d.values.push_back(*v);
   auto repeat = [&](const std::vector<float>& per_pixel) {
@@ -291,15 +364,25 @@ DeepSamples encode_lightfield(const LightField& lf) {
     for (const auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) repeat(*v);
   if (lf.has_modulation())
     for (const auto* v : {&lf.mod_r, &lf.mod_g, &lf.mod_b}) repeat(*v);
-  d.attributes["mcrecon:lightfield"] = effect_name(lf.effect);
+  auto text = [](float v) {
+    std::ostringstream os;
+    os.precision(9);
+    os << v;
+    return os.str();
+  };
+  if (lf.combined()) {
+    const LightField& u = *lf.lens;
+    if (u.r.size() != lf.samples() || u.smin.size() != np)
+      throw Error(Errc::Internal, "encode_lightfield: the lens arrays do not match the light field");
+    for (const auto* v : {&u.r, &u.g, &u.b, &u.y1, &u.y2}) d.values.push_back(*v);
+    for (const auto* v : {&u.smin, &u.smax}) repeat(*v);
+    d.attributes["mcrecon:lf_u_range"] = text(u.y_range);
+    d.attributes["mcrecon:lf_sigma_u"] = text(u.sigma_y);
+  }
+  d.attributes["mcrecon:lightfield"] = lightfield_kind(lf);
   d.attributes["mcrecon:lf_l"] = std::to_string(lf.l);
-  std::ostringstream yr, sy;
-  yr.precision(9);
-  sy.precision(9);
-  yr << lf.y_range;
-  sy << lf.sigma_y;
-  d.attributes["mcrecon:lf_y_range"] = yr.str();
-  d.attributes["mcrecon:lf_sigma_y"] = sy.str();
+  d.attributes["mcrecon:lf_y_range"] = text(lf.y_range);
+  d.attributes["mcrecon:lf_sigma_y"] = text(lf.sigma_y);
   return d;
 }
 

@@ -24,6 +24,7 @@
 // A pixel's bounds [smin, smax] span the slopes its samples saw; smin = smax = 0 says
 // nothing to shear (unoccluded, in focus, no reflector).
 #include <cstdint>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -64,6 +65,16 @@ struct LightField {
   // carried from a neighbour into the pixel (it left bright and dark rings around shadows).
   std::vector<float> mod_r, mod_g, mod_b;
 
+  // Soft shadows and depth of field together (Yan et al. 2015, appendix; the file's effect
+  // "soft_shadows+dof"): this light field is then the soft shadows' (y on the light, the shadow
+  // bounds and axes, mod the unoccluded light without the texture) with r, g, b each sample's
+  // whole value, and `lens` the same samples on the lens: effect Dof, y1, y2 the lens
+  // coordinate, r, g, b the texture k at the sample's hit (the whole value = k x the light
+  // there), smin, smax the lens slope bounds, e1 = (1, 0), e2 = (0, 1), the same depth, no
+  // geometry. Null for one effect. A pixel's estimate weighs a sample by the light's and the
+  // aperture's weights together.
+  std::shared_ptr<const LightField> lens;
+
   std::size_t nonfinite_replaced = 0;     // sample values decode replaced (non-finite)
 
   int spp() const { return l * l; }
@@ -72,6 +83,7 @@ struct LightField {
   bool has_geometry() const { return !px.empty() && !nx.empty(); }
   bool has_world_axes() const { return has_geometry() && !w1x.empty(); }
   bool has_modulation() const { return !mod_r.empty(); }
+  bool combined() const { return lens != nullptr; }
   // Allocates every array for width x height x l*l (geometry and world axes too when `geometry`).
   void resize(int w, int h, int l_, bool geometry);
 };
@@ -80,17 +92,23 @@ struct LightField {
 // each sample: lf.smin lf.smax lf.e1x lf.e1y lf.e2x lf.e2y Z, optionally P.X P.Y P.Z N.X N.Y N.Z
 // and with them lf.w1x lf.w1y lf.w1z lf.w2x lf.w2y lf.w2z; optionally lf.modR lf.modG lf.modB;
 // header attributes mcrecon:lightfield (effect), mcrecon:lf_l, mcrecon:lf_y_range,
-// mcrecon:lf_sigma_y.
-bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield
+// mcrecon:lf_sigma_y. Combined ("soft_shadows+dof"): also per sample lf.u1 lf.u2 (lens) and
+// lf.kR lf.kG lf.kB (texture), per pixel lf.dmin lf.dmax (lens bounds), mcrecon:lf_u_range and
+// mcrecon:lf_sigma_u.
+bool is_lightfield(const DeepSamples& deep);
+// The file's name of what lf holds: effect_name, or "soft_shadows+dof" when combined.
+std::string lightfield_kind(const LightField& lf);  // carries mcrecon:lightfield
 // The weight over one axis of y: the Gaussian light or aperture, exp(-y^2 / (2 sigma_y^2)), or
 // for gi the v-plane truncation (1 inside [-L, L], else 0). A pixel's unfiltered estimate is
 // the mean of its samples weighted by w(y1) w(y2).
 float lightfield_y_weight(LightFieldEffect effect, float sigma_y, float y_range, float y);
-// Sample k's weight in its pixel's unfiltered estimate: w(y1) w(y2).
+// Sample k's weight in its pixel's unfiltered estimate: w(y1) w(y2) (combined: times the
+// aperture's weight of its lens coordinate).
 float lightfield_sample_weight(const LightField& lf, std::size_t k);
 // Throws Error (BadInput / MissingPass) naming `path` and what is wrong: a missing channel or
 // attribute, a pixel without exactly l*l samples, a non-finite or out-of-range coordinate, a
-// non-finite slope or axis, l outside 1..64. Non-finite values become 0 (and are counted).
+// non-finite slope or axis, l outside 1..64. A non-finite value (or texture) takes its pixel's
+// finite mean (0 when none) and is counted.
 LightField decode_lightfield(const DeepSamples& deep, const std::string& path, std::size_t* nonfinite_values = nullptr);
 DeepSamples encode_lightfield(const LightField& lf);
 

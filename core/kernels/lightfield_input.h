@@ -25,6 +25,7 @@ ParamSpec residual_k_param();
 ParamSpec residual_radius_param();
 ParamSpec step_back_param();
 ParamSpec step_back_radius_param();
+ParamSpec lens_light_param();
 // residual_k as it applies to this effect and spp: -1 (the default) is 3 for depth of field and
 // soft shadows, 1 where the step back follows it (step_back_for, 2 samples a pixel or more), 0
 // for gi (residual_k_param says why).
@@ -56,6 +57,10 @@ void remodulate(const LightField& lf, const Roi& roi, Image& out);
 // against each pixel's own samples (the frame's flat colour; residual_k), step back toward
 // them where the filter is not estimated to beat them (step_back); returns the notes (the
 // counts, the non-finite values replaced, the pixels that took their residual, the step back).
+// Soft shadows through a lens (LightField::lens; Yan et al. 2015, appendix) run that twice:
+// the light (each sample's value over its texture) as soft shadows, then the lens (each
+// sample's texture times its light, lens_light) as depth of field, and step back toward the
+// frame's flat colour at the end (step_back auto: strata).
 using Core = void (*)(const LightField&, const Options&, const Roi&, int, Image&, Counts*);
 std::vector<std::string> run_on_frame(const Frame& frame, const std::string& filter, const Options& o, const Roi& roi,
                                       int nthreads, Image& out, Core core, bool sheared);

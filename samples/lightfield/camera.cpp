@@ -42,4 +42,12 @@ void Camera::screen_axis(const Vec3& p, const Vec3& d, double& ex, double& ey) c
   ey = (y1 - y0) / eps;
 }
 
+void thin_lens_ray(const Camera& cam, double focus_m, double aperture_radius_m, double px, double py, double u1,
+                   double u2, Vec3& org, Vec3& dir) {
+  const Vec3 centre_dir = cam.direction(px, py);
+  const Vec3 focus_point = cam.eye + centre_dir * (focus_m / dot(centre_dir, cam.forward));
+  org = cam.eye + cam.right * (u1 * aperture_radius_m) + cam.down * (u2 * aperture_radius_m);
+  dir = normalize(focus_point - org);
+}
+
 }  // namespace mcr::lfgen

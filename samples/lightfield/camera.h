@@ -23,4 +23,10 @@ struct Camera {
   void screen_axis(const Vec3& p, const Vec3& d, double& ex, double& ey) const;
 };
 
+// The ray of image point (px, py) through a thin lens's point (u1, u2) (in units of the
+// aperture radius, along the image's +x, +y): from that lens point to the image point's focus
+// on the plane at camera depth focus_m (every ray of the image point passes through it).
+void thin_lens_ray(const Camera& cam, double focus_m, double aperture_radius_m, double px, double py, double u1,
+                   double u2, Vec3& org, Vec3& dir);
+
 }  // namespace mcr::lfgen

@@ -25,13 +25,7 @@ Vec3 Dof::shade(const Hit& h) const {
 }
 
 void Dof::lens_ray(double px, double py, double u1, double u2, Vec3& org, Vec3& dir) const {
-  const Camera& cam = s_.camera;
-  const Vec3 centre_dir = cam.direction(px, py);
-  // Every ray of the image point passes through its point on the focus plane (depth F).
-  const Vec3 focus_point = cam.eye + centre_dir * (s_.lens.focus_m / dot(centre_dir, cam.forward));
-  const double A = s_.lens.aperture_radius_m();
-  org = cam.eye + cam.right * (u1 * A) + cam.down * (u2 * A);
-  dir = normalize(focus_point - org);
+  thin_lens_ray(s_.camera, s_.lens.focus_m, s_.lens.aperture_radius_m(), px, py, u1, u2, org, dir);
 }
 
 void Dof::render_pixel(int x, int y, int l, double j1, double j2, PixelSamples& out) const {

@@ -23,10 +23,17 @@ struct PixelSamples {
   Vec3 p, n;                    // receiver position and unit normal
   Vec3 w1, w2;                  // world dual axes: a receiver displacement D is D . w_i in x units
   Vec3 mod;                     // soft shadows: the unoccluded light (the value with nothing in the way)
+  // Soft shadows and depth of field together (LightField::lens): each sample's lens coordinate
+  // and texture, the pixel's lens slope bounds. Empty / 0 for one effect.
+  std::vector<double> u1, u2;
+  std::vector<Vec3> texture;
+  double dmin = 0, dmax = 0;
   void reset(int spp);
   // Widens [smin, smax] by one sample's slope (the first one sets both).
   void add_slope(double s);
-  bool has_slope = false;
+  // Widens [dmin, dmax] alike (the lens bounds of a combined scene).
+  void add_lens_slope(double s);
+  bool has_slope = false, has_lens_slope = false;
 };
 
 // Coordinate of stratum i (of l) with jitter j in [0,1) on [-L, L]: -L + (i + j) 2L / l.
@@ -44,11 +51,20 @@ class LightFieldGenerator {
   virtual void render_pixel(int x, int y, int l, double j1, double j2, PixelSamples& out) const = 0;
   // Extra header attributes ("mcrecon:*", as text) describing the scene (camera, light).
   virtual std::map<std::string, std::string> attributes() const { return {}; }
+  // Soft shadows seen through a lens (the appendix's combined effects): render_pixel also fills
+  // u1, u2, texture and the lens bounds; the lens coordinate spans [-u_range, u_range]^2 under
+  // a Gaussian aperture of standard deviation sigma_u.
+  virtual bool has_lens() const { return false; }
+  virtual double u_range() const { return 1.0; }
+  virtual double sigma_u() const { return 0.5; }
 
   // Weight of a sample at y in the converged pixel: the Gaussian light / aperture
   // exp(-|y|^2 / (2 sigma_y^2)) for soft shadows and dof, 1 for gi (its values already
   // carry the transfer over the pdf: the plain mean is the pixel).
   double reference_weight(double y1, double y2) const;
+  // Sample k's weight in its converged pixel: reference_weight, times the aperture's Gaussian
+  // of its lens coordinate with a lens.
+  double sample_weight(const PixelSamples& ps, std::size_t k) const;
 };
 
 // The registry: scene names ("soft_shadows", "dof", "gi") and their default scenes.
@@ -61,6 +77,10 @@ void check_samples_per_axis(int l);
 
 // Called with the number of rows finished (from one thread at a time, in no fixed order).
 using RowProgress = std::function<void(int rows_done)>;
+
+// A 64-bit mix (splitmix64's finaliser): hashes that stand in for random numbers, the same on
+// any thread count.
+unsigned long long mix64(unsigned long long x);
 
 // The pixel's jitter for a seed: a hash of (seed, salt, pixel), the same on any thread count.
 void pixel_jitter(unsigned long long seed, unsigned salt, std::size_t pixel, double& j1, double& j2);

@@ -27,7 +27,7 @@ std::vector<float> render_reference(const LightFieldGenerator& gen, int l, unsig
       Vec3 sum;
       double wsum = 0;
       for (std::size_t k = 0; k < ps.value.size(); ++k) {
-        const double wk = gen.reference_weight(ps.y1[k], ps.y2[k]);
+        const double wk = gen.sample_weight(ps, k);
         sum += ps.value[k] * wk;
         wsum += wk;
       }

@@ -5,6 +5,7 @@
 #include "generator.h"
 #include "gi.h"
 #include "soft_shadows.h"
+#include "soft_shadows_dof.h"
 #include "util/error.h"
 
 namespace mcr::lfgen {
@@ -16,6 +17,7 @@ const std::vector<std::pair<std::string, Factory>>& registry() {
       {"soft_shadows", make_soft_shadows},
       {"dof", make_dof},
       {"gi", make_gi},
+      {"soft_shadows_dof", make_soft_shadows_dof},
   };
   return r;
 }

@@ -1,7 +1,9 @@
 // Rendering every pixel of a light field: one jitter per pixel from a hash (so a seed gives
 // the same file on any thread count), rows in parallel.
+#include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <memory>
 #include <mutex>
 
 #include "generator.h"
@@ -19,6 +21,11 @@ void PixelSamples::reset(int spp) {
   e1x = e1y = e2x = e2y = 0;
   depth = 0;
   p = n = w1 = w2 = mod = Vec3();
+  u1.clear();
+  u2.clear();
+  texture.clear();
+  dmin = dmax = 0;
+  has_lens_slope = false;
 }
 
 void PixelSamples::add_slope(double s) {
@@ -31,23 +38,38 @@ void PixelSamples::add_slope(double s) {
   }
 }
 
+void PixelSamples::add_lens_slope(double s) {
+  if (!has_lens_slope) {
+    dmin = dmax = s;
+    has_lens_slope = true;
+  } else {
+    dmin = std::min(dmin, s);
+    dmax = std::max(dmax, s);
+  }
+}
+
 double LightFieldGenerator::reference_weight(double y1, double y2) const {
   if (effect() == LightFieldEffect::Gi) return 1.0;
   const double s = sigma_y();
   return std::exp(-(y1 * y1 + y2 * y2) / (2 * s * s));
 }
 
-namespace {
-unsigned long long splitmix64(unsigned long long x) {
+double LightFieldGenerator::sample_weight(const PixelSamples& ps, std::size_t k) const {
+  const double w = reference_weight(ps.y1[k], ps.y2[k]);
+  if (!has_lens()) return w;
+  const double s = sigma_u();
+  return w * std::exp(-(ps.u1[k] * ps.u1[k] + ps.u2[k] * ps.u2[k]) / (2 * s * s));
+}
+
+unsigned long long mix64(unsigned long long x) {
   x += 0x9e3779b97f4a7c15ULL;
   x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
   x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
   return x ^ (x >> 31);
 }
-}  // namespace
 
 void pixel_jitter(unsigned long long seed, unsigned salt, std::size_t pixel, double& j1, double& j2) {
-  const unsigned long long h = splitmix64(splitmix64(seed ^ (0x5851f42d4c957f2dULL * (salt + 1))) + pixel);
+  const unsigned long long h = mix64(mix64(seed ^ (0x5851f42d4c957f2dULL * (salt + 1))) + pixel);
   j1 = double(h >> 40) / double(1ULL << 24);  // 24 bits each: exact in float, in [0, 1)
   j2 = double((h >> 8) & 0xffffff) / double(1ULL << 24);
 }
@@ -71,6 +93,14 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
   const std::size_t spp = std::size_t(l) * std::size_t(l);
   if (lf.effect == LightFieldEffect::SoftShadows)
     for (auto* v : {&lf.mod_r, &lf.mod_g, &lf.mod_b}) v->assign(lf.pixels(), 0.f);
+  std::shared_ptr<LightField> lens;
+  if (gen.has_lens()) {
+    lens = std::make_shared<LightField>();
+    lens->resize(gen.width(), gen.height(), l, false);
+    lens->effect = LightFieldEffect::Dof;
+    lens->y_range = float(gen.u_range());
+    lens->sigma_y = float(gen.sigma_u());
+  }
   std::atomic<int> rows{0};
   std::mutex report;
   parallel_rows(0, gen.height(), nthreads, [&](int y) {
@@ -104,6 +134,21 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
       if (lf.has_modulation()) lf.mod_r[p] = float(ps.mod.x), lf.mod_g[p] = float(ps.mod.y), lf.mod_b[p] = float(ps.mod.z);
       lf.w1x[p] = float(ps.w1.x), lf.w1y[p] = float(ps.w1.y), lf.w1z[p] = float(ps.w1.z);
       lf.w2x[p] = float(ps.w2.x), lf.w2y[p] = float(ps.w2.y), lf.w2z[p] = float(ps.w2.z);
+      if (lens) {
+        LightField& u = *lens;
+        for (std::size_t k = 0; k < spp; ++k) {
+          u.r[p * spp + k] = float(ps.texture[k].x);
+          u.g[p * spp + k] = float(ps.texture[k].y);
+          u.b[p * spp + k] = float(ps.texture[k].z);
+          u.y1[p * spp + k] = float(ps.u1[k]);
+          u.y2[p * spp + k] = float(ps.u2[k]);
+        }
+        u.smin[p] = float(ps.dmin);
+        u.smax[p] = float(ps.dmax);
+        u.e1x[p] = 1;
+        u.e2y[p] = 1;
+        u.depth[p] = float(ps.depth);
+      }
     }
     const int done = ++rows;
     if (progress) {
@@ -114,6 +159,7 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
   // Depth of field measures x in pixels: no world axes (the screen axes are exact).
   if (lf.effect == LightFieldEffect::Dof)
     for (auto* v : {&lf.w1x, &lf.w1y, &lf.w1z, &lf.w2x, &lf.w2y, &lf.w2z}) v->clear();
+  lf.lens = lens;
   return lf;
 }
 

@@ -22,7 +22,23 @@ class SoftShadows : public LightFieldGenerator {
  public:
   explicit SoftShadows(const SoftShadowsSetup& setup) : s_(setup) {}
   Scene& scene() { return scene_; }  // add shapes, then commit()
+  const Scene& scene() const { return scene_; }
+  const SoftShadowsSetup& setup() const { return s_; }
   void commit() { scene_.commit(); }
+
+  // One light point (u1, u2) seen from receiver h: f, the light without the texture
+  // (radiance / pi cos_r cos_l / r^2), 0 where occluded (then `occluded` and the slope).
+  struct LightSample {
+    double f = 0;
+    bool occluded = false;
+    double slope = 0;  // d1/d2 - 1
+  };
+  LightSample light_sample(const Hit& h, double u1, double u2) const;
+  // The light at h with nothing in the way, times `texture`: the Gaussian-weighted mean over a
+  // 16 x 16 grid of the light (no rays: smooth, so the grid is converged).
+  Vec3 unoccluded(const Hit& h, const Vec3& texture) const;
+  // The receiver's axes: world duals w1, w2 and their screen lengths e1, e2.
+  void receiver_axes(const Hit& h, PixelSamples& out) const;
 
   LightFieldEffect effect() const override { return LightFieldEffect::SoftShadows; }
   double y_range() const override { return s_.half_side; }
@@ -40,5 +56,7 @@ class SoftShadows : public LightFieldGenerator {
 // The default scene: a ground plane under a light 4 units up (side 1.2, axes turned 20 degrees
 // about the vertical), a sphere, a thin bar and a box on the ground.
 std::unique_ptr<LightFieldGenerator> make_soft_shadows(int width, int height);
+// The same scene as its own type (the combined scene looks at it through a lens).
+std::unique_ptr<SoftShadows> make_soft_shadows_scene(int width, int height);
 
 }  // namespace mcr::lfgen

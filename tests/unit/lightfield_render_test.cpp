@@ -80,8 +80,8 @@ TEST(LightFieldRender, GiKeepsItsVPlaneRange) {
 }
 
 TEST(LightFieldRender, RegistryNamesItsScenes) {
-  EXPECT_EQ(scene_names(), (std::vector<std::string>{"soft_shadows", "dof", "gi"}));
-  testutil::expect_error(Errc::InvalidArgument, {"'shadows'", "soft_shadows, dof, gi"}, [] { make_scene("shadows", 8, 8); });
+  EXPECT_EQ(scene_names(), (std::vector<std::string>{"soft_shadows", "dof", "gi", "soft_shadows_dof"}));
+  testutil::expect_error(Errc::InvalidArgument, {"'shadows'", "soft_shadows, dof, gi, soft_shadows_dof"}, [] { make_scene("shadows", 8, 8); });
   testutil::expect_error(Errc::InvalidArgument, {"0x8"}, [] { make_scene("dof", 0, 8); });
   testutil::expect_error(Errc::InvalidArgument, {"l = 65"}, [] {
     const auto gen = make_scene("dof", 2, 2);

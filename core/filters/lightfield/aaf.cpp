@@ -19,7 +19,7 @@ const FilterInfo& AafFilter::static_info() {
                 "then a spatial Gaussian from the slope bounds";
     i.reference = "Mehta et al. 2012 (sigma_x from the minimum slope, mu); Yan et al. 2015 sec. 3.1, 5";
     i.params = with_preparation_params({lf::max_width_param(), lf::residual_k_param(), lf::residual_radius_param(),
-                                        lf::step_back_param(), lf::step_back_radius_param(),
+                                        lf::step_back_param(), lf::step_back_radius_param(), lf::lens_light_param(),
                                         lf::mu_param(false), lf::smooth_radius_param(), lf::bounds_radius_param(),
                                         lf::reject_param(), lf::normal_degrees_param()},
                                        PrepSteps::none());

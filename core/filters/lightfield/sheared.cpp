@@ -20,7 +20,7 @@ const FilterInfo& ShearedFilter::static_info() {
                 "indirect light, factored into four 1D steps";
     i.reference = "Yan et al. 2015, eq. 9-15; sec. 5 (16 bins, 32-pixel cap, slope smoothing, axis-aligned fallback)";
     i.params = with_preparation_params({lf::max_width_param(), lf::residual_k_param(), lf::residual_radius_param(),
-                                        lf::step_back_param(), lf::step_back_radius_param(),
+                                        lf::step_back_param(), lf::step_back_radius_param(), lf::lens_light_param(),
                                         lf::bins_param(), lf::fallback_param(),
                                         lf::mu_param(true), lf::smooth_radius_param(), lf::bounds_radius_param(), lf::reject_param(),
                                         lf::normal_degrees_param()},

@@ -19,7 +19,7 @@ const FilterInfo& Sheared4dFilter::static_info() {
                 "indirect light; the slow reference of 'sheared'";
     i.reference = "Yan et al. 2015, eq. 3-5, 9; sec. 5 (slope smoothing, axis-aligned fallback)";
     i.params = with_preparation_params({lf::max_width_param(), lf::residual_k_param(), lf::residual_radius_param(),
-                                        lf::step_back_param(), lf::step_back_radius_param(),
+                                        lf::step_back_param(), lf::step_back_radius_param(), lf::lens_light_param(),
                                         lf::fallback_param(), lf::mu_param(true),
                                         lf::smooth_radius_param(), lf::bounds_radius_param(), lf::reject_param(), lf::normal_degrees_param()},
                                        PrepSteps::none());
