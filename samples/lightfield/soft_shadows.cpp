@@ -105,7 +105,7 @@ std::unique_ptr<LightFieldGenerator> make_soft_shadows(int width, int height) {
   return make_soft_shadows_scene(width, height);
 }
 
-std::unique_ptr<SoftShadows> make_soft_shadows_scene(int width, int height) {
+std::unique_ptr<SoftShadows> make_soft_shadows_scene(int width, int height, double ground_checker) {
   SoftShadowsSetup s;
   s.camera = Camera::look_at(width, height, {0, -6.5, 4.5}, {0, -0.2, 0.4}, {0, 0, 1}, 45);
   const double H = 4, turn = 20 * M_PI / 180;
@@ -118,6 +118,8 @@ std::unique_ptr<SoftShadows> make_soft_shadows_scene(int width, int height) {
   Scene& sc = g->scene();
   Material ground;
   ground.albedo = {0.8, 0.8, 0.8};
+  ground.albedo2 = {0.35, 0.3, 0.25};
+  ground.checker = ground_checker;
   sc.add_quad({-40, -40, 0}, {80, 0, 0}, {0, 80, 0}, ground);  // fills the view to the top
   Material red, blue, yellow;
   red.albedo = {0.8, 0.25, 0.2};

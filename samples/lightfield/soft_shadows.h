@@ -56,7 +56,8 @@ class SoftShadows : public LightFieldGenerator {
 // The default scene: a ground plane under a light 4 units up (side 1.2, axes turned 20 degrees
 // about the vertical), a sphere, a thin bar and a box on the ground.
 std::unique_ptr<LightFieldGenerator> make_soft_shadows(int width, int height);
-// The same scene as its own type (the combined scene looks at it through a lens).
-std::unique_ptr<SoftShadows> make_soft_shadows_scene(int width, int height);
+// The same scene as its own type (the combined scene looks at it through a lens), the ground a
+// checker of squares ground_checker units wide (0.8 and (0.35, 0.3, 0.25)) unless 0 (plain).
+std::unique_ptr<SoftShadows> make_soft_shadows_scene(int width, int height, double ground_checker = 0);
 
 }  // namespace mcr::lfgen

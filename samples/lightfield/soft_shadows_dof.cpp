@@ -77,7 +77,7 @@ std::map<std::string, std::string> SoftShadowsDof::attributes() const {
 }
 
 std::unique_ptr<LightFieldGenerator> make_soft_shadows_dof(int width, int height) {
-  return std::make_unique<SoftShadowsDof>(make_soft_shadows_scene(width, height), 7.0, 0.35);
+  return std::make_unique<SoftShadowsDof>(make_soft_shadows_scene(width, height, 0.5), 7.0, 0.35);
 }
 
 }  // namespace mcr::lfgen

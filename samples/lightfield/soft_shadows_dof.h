@@ -34,9 +34,10 @@ class SoftShadowsDof : public LightFieldGenerator {
   double focus_m_, aperture_m_;
 };
 
-// The soft shadows scene through a lens focused on the ground under the light (7 m), aperture
-// radius 0.35 m: the near ground and the far ground blur by up to about 3 and 5 pixels per unit
-// of lens coordinate at 128 pixels wide.
+// The soft shadows scene, its ground a checker of half-unit squares (texture for the lens to
+// blur), through a lens focused on the ground under the light (7 m), aperture radius 0.35 m: the
+// near ground and the far ground blur by up to about 3 and 5 pixels per unit of lens coordinate
+// at 128 pixels wide.
 std::unique_ptr<LightFieldGenerator> make_soft_shadows_dof(int width, int height);
 
 }  // namespace mcr::lfgen
