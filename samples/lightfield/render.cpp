@@ -74,6 +74,20 @@ void pixel_jitter(unsigned long long seed, unsigned salt, std::size_t pixel, dou
   j2 = double((h >> 8) & 0xffffff) / double(1ULL << 24);
 }
 
+namespace {
+// Pixel p's samples into lf: colours and coordinates.
+void put_samples(const std::vector<Vec3>& colour, const std::vector<double>& y1, const std::vector<double>& y2,
+                 std::size_t p, std::size_t spp, LightField& lf) {
+  for (std::size_t k = 0; k < spp; ++k) {
+    lf.r[p * spp + k] = float(colour[k].x);
+    lf.g[p * spp + k] = float(colour[k].y);
+    lf.b[p * spp + k] = float(colour[k].z);
+    lf.y1[p * spp + k] = float(y1[k]);
+    lf.y2[p * spp + k] = float(y2[k]);
+  }
+}
+}  // namespace
+
 void check_samples_per_axis(int l) {
   if (l < 1 || l > 64) throw Error(Errc::InvalidArgument, "light field: l = " + std::to_string(l) + " samples per axis, expected 1..64");
 }
@@ -111,13 +125,7 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
       pixel_jitter(seed, 0, p, j1, j2);
       ps.reset(int(spp));
       gen.render_pixel(x, y, l, j1, j2, ps);
-      for (std::size_t k = 0; k < spp; ++k) {
-        lf.r[p * spp + k] = float(ps.value[k].x);
-        lf.g[p * spp + k] = float(ps.value[k].y);
-        lf.b[p * spp + k] = float(ps.value[k].z);
-        lf.y1[p * spp + k] = float(ps.y1[k]);
-        lf.y2[p * spp + k] = float(ps.y2[k]);
-      }
+      put_samples(ps.value, ps.y1, ps.y2, p, spp, lf);
       lf.smin[p] = float(ps.smin);
       lf.smax[p] = float(ps.smax);
       lf.e1x[p] = float(ps.e1x);
@@ -136,13 +144,7 @@ LightField render_lightfield(const LightFieldGenerator& gen, int l, unsigned lon
       lf.w2x[p] = float(ps.w2.x), lf.w2y[p] = float(ps.w2.y), lf.w2z[p] = float(ps.w2.z);
       if (lens) {
         LightField& u = *lens;
-        for (std::size_t k = 0; k < spp; ++k) {
-          u.r[p * spp + k] = float(ps.texture[k].x);
-          u.g[p * spp + k] = float(ps.texture[k].y);
-          u.b[p * spp + k] = float(ps.texture[k].z);
-          u.y1[p * spp + k] = float(ps.u1[k]);
-          u.y2[p * spp + k] = float(ps.u2[k]);
-        }
+        put_samples(ps.texture, ps.u1, ps.u2, p, spp, u);
         u.smin[p] = float(ps.dmin);
         u.smax[p] = float(ps.dmax);
         u.e1x[p] = 1;

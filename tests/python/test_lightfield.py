@@ -70,6 +70,23 @@ def write_deep(path, spec, chans, counts=None):
     out.close()
 
 
+def expect_same_in_python_and_plugin(test, lf, cli, out):
+    """`sheared` on lf through the Python module and the plugin (oiiotool's input mode) gives the
+    CLI's output `cli` bit for bit."""
+    sys.path.insert(0, os.environ.get("MCRECON_PYTHON_DIR") or os.path.join(tu.source_dir(), "build", "python"))
+    import mcrecon
+    py = out("py.exr")
+    mcrecon.Session("sheared", {}).denoise_file(lf, py)
+    test.assertTrue(np.array_equal(rgb(py), rgb(cli)), "Python differs from the CLI")
+    plugin = os.environ.get("MCRECON_PLUGIN_DIR") or os.path.join(tu.source_dir(), "build", "lib")
+    oiiotool = shutil.which("oiiotool") or "/usr/bin/oiiotool"
+    pl = out("plugin.exr")
+    r = subprocess.run([oiiotool, lf + ".mcrecon?filter=sheared", "-o", pl], capture_output=True, text=True,
+                       env=dict(os.environ, OIIO_LIBRARY_PATH=plugin), timeout=120)
+    test.assertEqual(r.returncode, 0, r.stderr)
+    test.assertTrue(np.array_equal(rgb(pl), rgb(cli)), "the plugin differs from the CLI")
+
+
 class LightFieldEndToEnd(unittest.TestCase):
     @classmethod
     def setUpClass(cls):
@@ -108,18 +125,7 @@ class LightFieldEndToEnd(unittest.TestCase):
         e_in, e_sh = relmse(ref, noisy), relmse(ref, rgb(cli))
         print(f"dof {W}x{H} 9 spp: relMSE input {e_in:.5f}, sheared {e_sh:.5f}")
         self.assertLess(e_sh, 0.6 * e_in)  # 0.45x measured
-        sys.path.insert(0, os.environ.get("MCRECON_PYTHON_DIR") or os.path.join(tu.source_dir(), "build", "python"))
-        import mcrecon
-        py = self.out("py.exr")
-        mcrecon.Session("sheared", {}).denoise_file(self.lf, py)
-        self.assertTrue(np.array_equal(rgb(py), rgb(cli)), "Python differs from the CLI")
-        plugin = os.environ.get("MCRECON_PLUGIN_DIR") or os.path.join(tu.source_dir(), "build", "lib")
-        oiiotool = shutil.which("oiiotool") or "/usr/bin/oiiotool"
-        pl = self.out("plugin.exr")
-        r = subprocess.run([oiiotool, self.lf + ".mcrecon?filter=sheared", "-o", pl], capture_output=True, text=True,
-                           env=dict(os.environ, OIIO_LIBRARY_PATH=plugin), timeout=120)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertTrue(np.array_equal(rgb(pl), rgb(cli)), "the plugin differs from the CLI")
+        expect_same_in_python_and_plugin(self, self.lf, cli, self.out)
 
     def test_sheared_matches_the_brute_force_filter(self):
         a, b = self.out("sh.exr"), self.out("sh4d.exr")
@@ -210,18 +216,7 @@ class SoftShadowsThroughALens(unittest.TestCase):
         e_in, e_sh = relmse(ref, rgb(flat)), relmse(ref, rgb(cli))
         print(f"soft shadows through a lens 48x40 16 spp: relMSE input {e_in:.5f}, sheared {e_sh:.5f}")
         self.assertLess(e_sh, 0.8 * e_in)
-        sys.path.insert(0, os.environ.get("MCRECON_PYTHON_DIR") or os.path.join(tu.source_dir(), "build", "python"))
-        import mcrecon
-        py = self.out("py.exr")
-        mcrecon.Session("sheared", {}).denoise_file(self.lf, py)
-        self.assertTrue(np.array_equal(rgb(py), rgb(cli)), "Python differs from the CLI")
-        plugin = os.environ.get("MCRECON_PLUGIN_DIR") or os.path.join(tu.source_dir(), "build", "lib")
-        oiiotool = shutil.which("oiiotool") or "/usr/bin/oiiotool"
-        pl = self.out("plugin.exr")
-        r = subprocess.run([oiiotool, self.lf + ".mcrecon?filter=sheared", "-o", pl], capture_output=True, text=True,
-                           env=dict(os.environ, OIIO_LIBRARY_PATH=plugin), timeout=120)
-        self.assertEqual(r.returncode, 0, r.stderr)
-        self.assertTrue(np.array_equal(rgb(pl), rgb(cli)), "the plugin differs from the CLI")
+        expect_same_in_python_and_plugin(self, self.lf, cli, self.out)
 
     def out(self, name):
         return os.path.join(self.dir, name)
