@@ -9,7 +9,7 @@ reference. Then, per l in 2, 3, 4: the samples `aaf` needs to reach `sheared`'s 
 between the two and the speed ratio). With --blender DIR, the Blender depth-of-field light
 field (samples/scenes/lightfield_dof.py) against the image-space filters at equal samples.
 
-    bench/lightfield_curves.py --mcrecon build/bin/mcrecon --out DIR [--scenes soft_shadows dof gi]
+    bench/lightfield_curves.py --mcrecon build/bin/mcrecon --out DIR [--scenes soft_shadows dof gi soft_shadows_dof]
         [--max-l 8] [--max-l-4d 4] [--size 128] [--blender samples/data/lightfield]
 
 Writes DIR/lightfield_curves.json and prints markdown tables. Times are the filter's own wall
@@ -125,7 +125,7 @@ def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--mcrecon", default="build/bin/mcrecon")
     p.add_argument("--out", required=True)
-    p.add_argument("--scenes", nargs="+", default=["soft_shadows", "dof", "gi"])
+    p.add_argument("--scenes", nargs="+", default=["soft_shadows", "dof", "gi", "soft_shadows_dof"])
     p.add_argument("--max-l", type=int, default=8)
     p.add_argument("--max-l-4d", type=int, default=4)
     p.add_argument("--size", type=int, default=128)
