@@ -183,9 +183,14 @@ void own_mean(const LightField& lf, const WeightY& wy, std::size_t p, float* rgb
 
 bool converged(const LightField& lf, std::size_t p) {
   if (lf.spp() < 2) return false;  // one sample says nothing of its pixel's spread
-  const std::size_t k0 = p * std::size_t(lf.spp()), k1 = k0 + std::size_t(lf.spp());
-  for (std::size_t k = k0 + 1; k < k1; ++k)
-    if (lf.r[k] != lf.r[k0] || lf.g[k] != lf.g[k0] || lf.b[k] != lf.b[k0]) return false;
+  const std::size_t spp = std::size_t(lf.spp()), k0 = p * spp;
+  const int x = int(p % std::size_t(lf.width)), y = int(p / std::size_t(lf.width));
+  for (int qy = std::max(0, y - 1); qy <= std::min(lf.height - 1, y + 1); ++qy)
+    for (int qx = std::max(0, x - 1); qx <= std::min(lf.width - 1, x + 1); ++qx) {
+      const std::size_t j0 = (std::size_t(qy) * std::size_t(lf.width) + std::size_t(qx)) * spp;
+      for (std::size_t k = 0; k < spp; ++k)
+        if (lf.r[j0 + k] != lf.r[k0] || lf.g[j0 + k] != lf.g[k0] || lf.b[j0 + k] != lf.b[k0]) return false;
+    }
   return true;
 }
 

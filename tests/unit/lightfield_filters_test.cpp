@@ -81,11 +81,16 @@ LightField counting_field() {
   lf.smax[15 * 20 + 15] = 2;
   lf.smin[3 * 20 + 15] = 0;
   lf.smax[3 * 20 + 15] = 2;
-  for (std::size_t k = std::size_t(2 * 20 + 2) * 4; k < std::size_t(2 * 20 + 3) * 4; ++k) {
-    lf.r[k] = 0.25f;
-    lf.g[k] = 0.5f;
-    lf.b[k] = 0.75f;
-  }
+  // Converged: the samples of (2, 2) and of its 8 neighbours agree. (4, 12) agrees with itself
+  // alone (4 samples can, by chance): not converged.
+  for (int y = 1; y <= 3; ++y)
+    for (int x = 1; x <= 3; ++x)
+      for (std::size_t k = std::size_t(y * 20 + x) * 4; k < std::size_t(y * 20 + x + 1) * 4; ++k) {
+        lf.r[k] = 0.25f;
+        lf.g[k] = 0.5f;
+        lf.b[k] = 0.75f;
+      }
+  for (std::size_t k = std::size_t(12 * 20 + 4) * 4; k < std::size_t(12 * 20 + 5) * 4; ++k) lf.r[k] = lf.g[k] = lf.b[k] = 2.0f;
   return lf;
 }
 
@@ -110,6 +115,7 @@ TEST(LightFieldFilters, CountsSkippedFallbackConvergedAndSmoothedPixels) {
         EXPECT_NEAR(out.data()[p * 3 + std::size_t(ch)], own_gauss_mean(lf, p, ch), 1e-5) << f.name << " " << p;
     EXPECT_EQ(out.at(2, 2, 0), 0.25f) << f.name;
     EXPECT_EQ(out.at(2, 2, 2), 0.75f) << f.name;
+    EXPECT_LT(out.at(4, 12, 0), 1.9f) << f.name << ": a pixel whose own samples alone agree is filtered";
     // Filtered pixels are not their own mean.
     EXPECT_GT(std::fabs(out.at(3, 10, 0) - own_gauss_mean(lf, 10 * 20 + 3, 0)), 1e-3) << f.name;
   }
