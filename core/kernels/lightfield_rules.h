@@ -44,9 +44,9 @@ struct Options {
   enum class StepBack { ByEffect, Off, Strata, Samples } step_back = StepBack::ByEffect;
   int step_back_radius = 3;
   // Soft shadows through a lens (LightField::lens): the light each sample takes into the lens
-  // stage: its pixel's filtered light plus its own departure from its pixel's mean (false), or
-  // its pixel's filtered light alone (true: the appendix of Yan et al. 2015).
-  bool combined_per_pixel = false;
+  // stage: its pixel's filtered light alone (true: the appendix of Yan et al. 2015), or that plus
+  // its own departure from its pixel's mean (false).
+  bool combined_per_pixel = true;
   // sheared (factored): memory for a band of rows' pre-convolved values (steps 1a, 2a); rows
   // beyond it go to further bands (same result). Not a parameter; tests make it small.
   std::size_t band_bytes = std::size_t(512) << 20;
