@@ -300,11 +300,23 @@ LightField decode_lightfield(const DeepSamples& deep, const std::string& path, s
   return lf;
 }
 
+bool lightfield_converged(const LightField& lf, std::size_t p) {
+  if (lf.spp() < 2) return false;  // one sample says nothing of its pixel's spread
+  const std::size_t spp = std::size_t(lf.spp()), k0 = p * spp;
+  const int x = int(p % std::size_t(lf.width)), y = int(p / std::size_t(lf.width));
+  for (int qy = std::max(0, y - 1); qy <= std::min(lf.height - 1, y + 1); ++qy)
+    for (int qx = std::max(0, x - 1); qx <= std::min(lf.width - 1, x + 1); ++qx) {
+      const std::size_t j0 = (std::size_t(qy) * std::size_t(lf.width) + std::size_t(qx)) * spp;
+      for (std::size_t k = 0; k < spp; ++k)
+        if (lf.r[j0 + k] != lf.r[k0] || lf.g[j0 + k] != lf.g[k0] || lf.b[j0 + k] != lf.b[k0]) return false;
+    }
+  return true;
+}
+
 LightFieldSummary summarize(const LightField& lf) {
   LightFieldSummary s;
   bool first = true;
   double e1 = 0, e2 = 0;
-  const std::size_t spp = std::size_t(lf.spp());
   for (std::size_t p = 0; p < lf.pixels(); ++p) {
     const float a = lf.smin[p], b = lf.smax[p];
     if (a == 0 && b == 0) {
@@ -315,12 +327,7 @@ LightFieldSummary summarize(const LightField& lf) {
       first = false;
       s.opposite_signs += a * b < 0;
     }
-    bool same = true;
-    for (std::size_t k = 1; k < spp && same; ++k) {
-      const std::size_t i = p * spp;
-      same = lf.r[i + k] == lf.r[i] && lf.g[i + k] == lf.g[i] && lf.b[i + k] == lf.b[i];
-    }
-    s.converged += same;
+    s.converged += lightfield_converged(lf, p);
     e1 += std::hypot(lf.e1x[p], lf.e1y[p]);
     e2 += std::hypot(lf.e2x[p], lf.e2y[p]);
   }

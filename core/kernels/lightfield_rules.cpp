@@ -153,7 +153,7 @@ std::vector<Rule> pixel_rules(const LightField& lf, const Options& o, Mode mode,
     r.inv2sx2 = inv2s2(sigma);
     r.r1 = radius_for(sigma, r.len1, cap);
     r.r2 = radius_for(sigma, r.len2, cap);
-    r.own_output = converged(lf, p);
+    r.own_output = lightfield_converged(lf, p);
     if (r.own_output && in) ++c.converged;
   }
   c.pixels = std::size_t(std::max(0, roi.width())) * std::size_t(std::max(0, roi.height()));
@@ -179,19 +179,6 @@ void own_mean(const LightField& lf, const WeightY& wy, std::size_t p, float* rgb
     const double v = ws > 0 ? s[c] / ws : (cnt > 0 ? t[c] / cnt : 0.0);
     rgb[c] = std::isfinite(v) ? float(v) : 0.0f;
   }
-}
-
-bool converged(const LightField& lf, std::size_t p) {
-  if (lf.spp() < 2) return false;  // one sample says nothing of its pixel's spread
-  const std::size_t spp = std::size_t(lf.spp()), k0 = p * spp;
-  const int x = int(p % std::size_t(lf.width)), y = int(p / std::size_t(lf.width));
-  for (int qy = std::max(0, y - 1); qy <= std::min(lf.height - 1, y + 1); ++qy)
-    for (int qx = std::max(0, x - 1); qx <= std::min(lf.width - 1, x + 1); ++qx) {
-      const std::size_t j0 = (std::size_t(qy) * std::size_t(lf.width) + std::size_t(qx)) * spp;
-      for (std::size_t k = 0; k < spp; ++k)
-        if (lf.r[j0 + k] != lf.r[k0] || lf.g[j0 + k] != lf.g[k0] || lf.b[j0 + k] != lf.b[k0]) return false;
-    }
-  return true;
 }
 
 Rejection::Rejection(const LightField& lf, const Options& o) : lf_(&lf) {

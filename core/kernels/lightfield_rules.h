@@ -104,12 +104,6 @@ inline float weight_x(float d2, float inv2sx2) { return std::exp(-d2 * inv2sx2);
 // The pixel's own sum over its samples of f w_y(y1) w_y(y2) / the sum of the weights (their
 // plain mean when every weight is 0). rgb: 3 floats.
 void own_mean(const LightField& lf, const WeightY& wy, std::size_t p, float* rgb);
-// All l*l samples of pixel p and of its 8 neighbours (those inside the image) carry the same
-// colour (never with l = 1). The pixel's own samples alone agree by chance where few of them meet
-// a fine pattern (4 samples of a slightly defocused checker, of a penumbra): such pixels were
-// kept as their own samples beside filtered neighbours, salt and pepper (dof at 4 spp: sheared
-// 0.0214 with the own-samples rule, 0.0070 with the 3x3 one; at 64 spp 0.00118 / 0.00117).
-bool converged(const LightField& lf, std::size_t p);
 
 // Neighbour rejection (soft shadows and gi with geometry; inactive otherwise): Q is not used
 // for P when their normals differ by more than normal_degrees, or when |pos_Q - pos_P| >
