@@ -95,9 +95,9 @@ struct LightField {
 // mcrecon:lf_sigma_y. Combined ("soft_shadows+dof"): also per sample lf.u1 lf.u2 (lens) and
 // lf.kR lf.kG lf.kB (texture), per pixel lf.dmin lf.dmax (lens bounds), mcrecon:lf_u_range and
 // mcrecon:lf_sigma_u.
-bool is_lightfield(const DeepSamples& deep);
+bool is_lightfield(const DeepSamples& deep);  // carries mcrecon:lightfield
 // The file's name of what lf holds: effect_name, or "soft_shadows+dof" when combined.
-std::string lightfield_kind(const LightField& lf);  // carries mcrecon:lightfield
+std::string lightfield_kind(const LightField& lf);
 // The weight over one axis of y: the Gaussian light or aperture, exp(-y^2 / (2 sigma_y^2)), or
 // for gi the v-plane truncation (1 inside [-L, L], else 0). A pixel's unfiltered estimate is
 // the mean of its samples weighted by w(y1) w(y2).

@@ -192,6 +192,19 @@ void remodulate(const LightField& lf, const Roi& roi, Image& out) {
 
 namespace {
 
+// The step back (sb, unless Off or one sample a pixel): out blended toward `own` where the filter
+// is not estimated to beat it, with the variance of lf's samples; a note "<who>: step back ...".
+void step_back(const LightField& lf, const Image& own, const std::string& who, const std::string& what,
+               Options::StepBack sb, const Options& o, const Roi& roi, int nthreads, Image& out,
+               std::vector<std::string>& notes) {
+  if (sb == Options::StepBack::Off || lf.spp() < 2) return;
+  const bool strata = sb == Options::StepBack::Strata;
+  const Image var = estimate_variance(lf, strata ? VarianceFrom::Strata : VarianceFrom::Samples, roi, nthreads);
+  const double a = blend_by_risk(own, var, roi, o.step_back_radius, nthreads, out);
+  notes.push_back(who + ": step back toward each pixel's own samples" + what + " (" + (strata ? "strata" : "samples") +
+                  " variance): mean weight of the filter's result " + rounded_text(a, 3));
+}
+
 // One effect's filtering of `decoded` (samples as the file holds them, or one stage of a combined
 // light field) into out inside roi: demodulate, core, multiply back, residual against `own` (the
 // pixels' own estimates), step back toward them. Returns the notes, each starting with `who`.
@@ -214,13 +227,7 @@ std::vector<std::string> run_stage(const std::shared_ptr<const LightField>& deco
     notes.push_back(who + ": " + std::to_string(taken) + " pixels took back over half of what the filter missed "
                     "against their own samples (residual_k)");
   }
-  if (const Options::StepBack sb = step_back_for(o, lf.effect); sb != Options::StepBack::Off && lf.spp() > 1) {
-    const bool strata = sb == Options::StepBack::Strata;
-    const Image var = estimate_variance(*decoded, strata ? VarianceFrom::Strata : VarianceFrom::Samples, roi, nthreads);
-    const double a = blend_by_risk(own, var, roi, o.step_back_radius, nthreads, out);
-    notes.push_back(who + ": step back toward each pixel's own samples (" + (strata ? "strata" : "samples") +
-                    " variance): mean weight of the filter's result " + rounded_text(a, 3));
-  }
+  step_back(*decoded, own, who, "", step_back_for(o, lf.effect), o, roi, nthreads, out, notes);
   return notes;
 }
 
@@ -311,15 +318,8 @@ std::vector<std::string> run_combined(const std::shared_ptr<const LightField>& d
     notes.push_back(std::move(n));
   // The two stages together against the frame's own estimates (the soft shadows' rule: the
   // strata of the lens meet shuffled strata of the light, so their halves see independent light).
-  if (const Options::StepBack sb = step_back_for(o, LightFieldEffect::SoftShadows);
-      sb != Options::StepBack::Off && all.spp() > 1) {
-    const bool strata = sb == Options::StepBack::Strata;
-    const Image var = estimate_variance(all, strata ? VarianceFrom::Strata : VarianceFrom::Samples, roi, nthreads);
-    const double a = blend_by_risk(flat, var, roi, o.step_back_radius, nthreads, out);
-    notes.push_back(filter + ": step back toward each pixel's own samples, both stages (" +
-                    (strata ? "strata" : "samples") + " variance): mean weight of the filter's result " +
-                    rounded_text(a, 3));
-  }
+  step_back(all, flat, filter, ", both stages", step_back_for(o, LightFieldEffect::SoftShadows), o, roi, nthreads, out,
+            notes);
   return notes;
 }
 

@@ -28,25 +28,18 @@ void PixelSamples::reset(int spp) {
   has_lens_slope = false;
 }
 
-void PixelSamples::add_slope(double s) {
-  if (!has_slope) {
-    smin = smax = s;
-    has_slope = true;
-  } else {
-    smin = std::min(smin, s);
-    smax = std::max(smax, s);
-  }
+namespace {
+// Widens [lo, hi] by s (the first one, has false, sets both).
+void widen(double s, bool& has, double& lo, double& hi) {
+  lo = has ? std::min(lo, s) : s;
+  hi = has ? std::max(hi, s) : s;
+  has = true;
 }
+}  // namespace
 
-void PixelSamples::add_lens_slope(double s) {
-  if (!has_lens_slope) {
-    dmin = dmax = s;
-    has_lens_slope = true;
-  } else {
-    dmin = std::min(dmin, s);
-    dmax = std::max(dmax, s);
-  }
-}
+void PixelSamples::add_slope(double s) { widen(s, has_slope, smin, smax); }
+
+void PixelSamples::add_lens_slope(double s) { widen(s, has_lens_slope, dmin, dmax); }
 
 double LightFieldGenerator::reference_weight(double y1, double y2) const {
   if (effect() == LightFieldEffect::Gi) return 1.0;
