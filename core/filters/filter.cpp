@@ -272,7 +272,8 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   if (info_.steps.step_back && params_.get_bool("step_back") && step_back_applies()) {
     const Pass* variance = prepared_.frame->find(Role::Variance);
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
-                                       nthreads, out, variance ? &variance->image : nullptr);
+                                       nthreads, out, variance ? &variance->image : nullptr,
+                                       params_.get_float("step_back_noise"));
     note(std::string("step_back") + (variance ? " (noise from the variance pass)" : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }

@@ -52,9 +52,22 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                   "averaged away) is undone; fireflies still go"));
     own.push_back(ParamSpec::Int("step_back_radius", 4, 1, 16,
                                  "half width of the window over which step_back weighs the result against the input"));
+    own.push_back(ParamSpec::Float("step_back_noise", 1.0, 0.25, 2.0,
+                                   "without a variance pass, step_back takes the image's noise estimate times this: "
+                                   "the estimate is right at a window's median but spreads (0.5-1.5x the truth), and a "
+                                   "window whose estimate runs low steps back from a sound result; up to 2 the blend "
+                                   "is still no worse than the input where the estimate is right (Stein's risk)"));
   }
   own.push_back(components_param());
   return own;
+}
+
+void edge_keeping_step_back(ParamTable& t) {
+  for (ParamSpec& s : t)
+    if (s.name == "step_back_noise") {
+      s.default_value = 2.0;
+      s.help += " (default 2 for this filter: its weights keep edges)";
+    }
 }
 
 ParamSpec components_param() {
@@ -134,6 +147,8 @@ std::vector<std::string> preparation_unused(const ParamSet& params, const PrepSt
   if (steps.demodulate && !params.get_bool("demodulate")) report_unused(params, "albedo_floor", "with demodulate=false", notes);
   if (steps.step_back && !params.get_bool("step_back"))
     report_unused(params, "step_back_radius", "with step_back=false", notes);
+  if (steps.step_back && !params.get_bool("step_back"))
+    report_unused(params, "step_back_noise", "with step_back=false", notes);
   return notes;
 }
 

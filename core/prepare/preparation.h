@@ -11,7 +11,7 @@
 //                    firefly_radius; then every channel clamped to [-clamp, clamp] (0 = off)
 // and one step after run() and remodulation:
 //   step_back        the result blended toward the input wherever it is not estimated to
-//                    beat it (prepare/step_back.h): step_back, step_back_radius
+//                    beat it (prepare/step_back.h): step_back, step_back_radius, step_back_noise
 // A filter states which steps it takes (FilterInfo::steps); its parameter table gets the
 // parameters of those steps only, and no filter reads them: run() receives their result.
 // Each step works on the region the filter reads (the roi grown by its reach); outside
@@ -37,6 +37,13 @@ struct PrepSteps {
 constexpr double kDefaultFireflyK = 8.0;
 
 ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps);
+
+// The filters whose weights already keep edges (bilateral, atrous, pwaf) default to
+// step_back_noise = 2: their results are sound where the noise estimate runs low, and a
+// step back there only brings noise back (chosen on the tune scenes room and glossy at 1-64
+// spp, 1 / 1.5 / 2 / 3: better at each step for the three, worse for gaussian and guided,
+// whose blur crosses texture and is undone best by the estimate as it is; 2 is the cap).
+void edge_keeping_step_back(ParamTable& t);
 
 // `components` (beauty | light_passes), in every filter's table so that every front end
 // takes it by the same name; the pipeline reads it (pipeline/components.h), no filter does.

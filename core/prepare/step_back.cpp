@@ -20,7 +20,9 @@ double clamp_float(double v) { return std::min(std::max(v, -double(kMax)), doubl
 }  // namespace
 
 StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int nthreads, Image& out,
-                        const Image* variance) {
+                        const Image* variance, double noise_scale) {
+  // A variance pass is each pixel's own: exact in expectation, it is not scaled.
+  const double scale = variance ? 1.0 : std::min(std::max(noise_scale, 0.0), 2.0);
   StepBackStats st;
   const int W = input.width(), H = input.height();
   const Roi roi = roi_in.clipped(W, H);
@@ -48,7 +50,7 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
       for (int c = 0; c < 3; ++c) {
         const double w = 1.0 / (double(m[c]) * m[c] + kRelMseEps);
         const double d = double(f[c]) - double(p[c]);
-        nv += w * ns.variance_of(i, c);
+        nv += w * scale * ns.variance_of(i, c);
         dv += w * d * d;
       }
       num.set(x - roi.x0, y - roi.y0, nv);

@@ -18,6 +18,12 @@
 // With s^2 estimated within 2x of the truth the blend is never worse than the input in
 // expectation; the estimate errs low on ramps and blur (less filtering), high on sharp
 // highlights (which the per-pixel limits catch).
+// The estimate is right at the median of a window but spreads around it (true / estimated over
+// 9x9 windows of the sample stills at 4 spp: 10th-90th percentile 0.46-1.49): with noise_scale
+// 1, a window whose estimate runs low steps back from a sound result. Stein's risk of the blend
+// with the variance scaled by k is s^2 - (2k - k^2) gain: with k <= 2 still no worse than the
+// input where the estimate is right; a result that beats the input keeps a = 1 (clamped) down
+// to an estimate 1/k of the truth.
 // Non-finite input pixels keep the filter's value and take no part in any window.
 #include <cstddef>
 
@@ -34,7 +40,10 @@ struct StepBackStats {
 // input: the colour the filter was given (RGB in its first channels, the frame's size);
 // out: the filter's RGB result, changed inside roi only; variance: the frame's variance
 // pass or null (kernels/noise_scale.h).
+// noise_scale: without a variance pass, the image's noise estimate is multiplied by it (at most
+// 2: the blend of a biased result then still keeps the input's risk where the estimate is right;
+// above 1 a sound filter keeps its result where the estimate runs low; see below).
 StepBackStats step_back(const Image& input, const Roi& roi, int radius, int nthreads, Image& out,
-                        const Image* variance = nullptr);
+                        const Image* variance = nullptr, double noise_scale = 1.0);
 
 }  // namespace mcr

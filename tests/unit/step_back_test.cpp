@@ -67,6 +67,53 @@ TEST(StepBack, ABiasedFilterIsNoWorseThanTheInputOrItself) {
   }
 }
 
+// The image's noise estimate spreads around the truth window by window: with the truth as the
+// result, windows whose estimate runs low step back toward the noise; twice the estimate keeps it.
+TEST(StepBack, TwiceTheNoiseKeepsASoundResultWhereTheEstimateRunsLow) {
+  for (double sigma : {0.1, 0.3}) {
+    SCOPED_TRACE(sigma);
+    Image clean;
+    const Image noisy = scene(96, 72, sigma, 7, &clean);
+    Image once = clean, twice = clean;
+    const StepBackStats s1 = step_back(noisy, Roi::all(96, 72), 4, 2, once, nullptr, 1.0);
+    const StepBackStats s2 = step_back(noisy, Roi::all(96, 72), 4, 2, twice, nullptr, 2.0);
+    EXPECT_GT(s2.mean_weight, s1.mean_weight);
+    EXPECT_LT(relmse(twice, clean), 0.8 * relmse(once, clean));
+  }
+}
+
+// Stein's risk with the variance scaled by k is s^2 - (2k - k^2) gain: up to k = 2 a biased
+// result blended back is still no worse than the input; above 2 the scale is capped.
+TEST(StepBack, UpToTwiceTheNoiseABiasedFilterIsNoWorseThanTheInput) {
+  for (double sigma : {0.03, 0.1, 0.3, 1.0}) {
+    SCOPED_TRACE(sigma);
+    Image clean;
+    const Image noisy = scene(96, 72, sigma, 3, &clean);
+    const Image blurred = box_blur(noisy, 4);
+    Image out = blurred, capped = blurred;
+    step_back(noisy, Roi::all(96, 72), 4, 2, out, nullptr, 2.0);
+    step_back(noisy, Roi::all(96, 72), 4, 2, capped, nullptr, 50.0);
+    EXPECT_LT(relmse(out, clean), relmse(noisy, clean));
+    EXPECT_LT(relmse(out, clean), relmse(blurred, clean));
+    EXPECT_EQ(out.storage(), capped.storage());
+  }
+}
+
+// A variance pass is each pixel's own, exact in expectation: it is not scaled.
+TEST(StepBack, AVariancePassIsNotScaled) {
+  Image clean;
+  const Image noisy = scene(64, 48, 0.2, 8, &clean);
+  Image var(64, 48, 3);
+  for (int y = 0; y < 48; ++y)
+    for (int x = 0; x < 64; ++x)
+      for (int c = 0; c < 3; ++c) var.at(x, y, c) = float(std::pow(0.2 * clean.at(x, y, c), 2));
+  const Image blurred = box_blur(noisy, 3);
+  Image a = blurred, b = blurred;
+  step_back(noisy, Roi::all(64, 48), 4, 2, a, &var, 1.0);
+  step_back(noisy, Roi::all(64, 48), 4, 2, b, &var, 2.0);
+  EXPECT_EQ(a.storage(), b.storage());
+}
+
 TEST(StepBack, AFireflyGoesAndItsLightStaysWhereItWas) {
   Image clean;
   Image noisy = scene(48, 48, 0.05, 4, &clean);
@@ -154,7 +201,7 @@ TEST(StepBack, EveryImageFilterTakesItByDefault) {
     off->commit();
     const Image b = off->execute(f);
     Image expect = b;
-    step_back(f.image(Role::Colour), Roi::all(40, 30), 4, 0, expect);
+    step_back(f.image(Role::Colour), Roi::all(40, 30), 4, 0, expect, nullptr, on->params().get_float("step_back_noise"));
     EXPECT_EQ(a.storage(), expect.storage());
   }
 }

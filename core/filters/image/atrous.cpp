@@ -59,6 +59,7 @@ const FilterInfo& AtrousFilter::static_info() {
     i.summary = "Edge-avoiding A-Trous wavelet filter: iterated cross-bilateral passes with a dilated 3/5/9-tap kernel";
     i.reference = "Dammertz, Sewtz, Hanika, Lensch 2010 (HPG); Immonen 2017, sections 3.3, 4.1, 5.3, 5.4";
     i.params = atrous_params();
+    edge_keeping_step_back(i.params);
     i.required = {Role::Colour};
     i.optional = {Role::Normal, Role::Position, Role::Albedo, Role::Depth};
     i.nonfinite_policy =

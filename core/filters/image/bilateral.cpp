@@ -31,6 +31,7 @@ const FilterInfo& BilateralFilter::static_info() {
     i.summary = "Cross-bilateral filter: spatial Gaussian times colour, normal, position, albedo and depth weights";
     i.reference = "Immonen 2017, sections 3.4 and 5.3 (Cross-Bilateral); Tomasi & Manduchi 1998; Eisemann & Durand 2004";
     i.params = with_common_params(with_noise_defaults(cross_bilateral_fit_params()));
+    edge_keeping_step_back(i.params);
     i.required = {Role::Colour};
     i.optional = {Role::Normal, Role::Position, Role::Albedo, Role::Depth};
     i.nonfinite_policy =

@@ -143,6 +143,7 @@ const FilterInfo& PwafFilter::static_info() {
     // render Gc let textures blur (glossy 64 spp: 0.0103 against the input's 0.0066; 0.0056
     // demodulated). Without an albedo pass the step is skipped with a note unless
     // demodulate=true was given (prepare/preparation.h).
+    edge_keeping_step_back(i.params);
     for (ParamSpec& s : i.params)
       if (s.name == "demodulate") {
         s.default_value = true;
