@@ -271,10 +271,11 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   if (repaired_) note(std::to_string(repaired_) + " non-finite output values replaced by 0");
   if (info_.steps.step_back && params_.get_bool("step_back") && step_back_applies()) {
     const Pass* variance = prepared_.frame->find(Role::Variance);
+    const double k = step_back_noise_for(params_, *prepared_.frame);
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
-                                       nthreads, out, variance ? &variance->image : nullptr,
-                                       params_.get_float("step_back_noise"));
-    note(std::string("step_back") + (variance ? " (noise from the variance pass)" : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
+                                       nthreads, out, variance ? &variance->image : nullptr, k);
+    note(std::string("step_back") +
+         (variance ? " (noise from the variance pass)" : k != 1.0 ? " (noise estimate x" + rounded_text(k, 2) + ")" : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
   prepared_.own = Frame{};  // the copied passes are not kept between frames

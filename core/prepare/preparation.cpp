@@ -52,11 +52,12 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                   "averaged away) is undone; fireflies still go"));
     own.push_back(ParamSpec::Int("step_back_radius", 4, 1, 16,
                                  "half width of the window over which step_back weighs the result against the input"));
-    own.push_back(ParamSpec::Float("step_back_noise", 1.0, 0.25, 2.0,
+    own.push_back(ParamSpec::Float("step_back_noise", 1.0, 0.0, 2.0,
                                    "without a variance pass, step_back takes the image's noise estimate times this: "
                                    "the estimate is right at a window's median but spreads (0.5-1.5x the truth), and a "
                                    "window whose estimate runs low steps back from a sound result; up to 2 the blend "
-                                   "is still no worse than the input where the estimate is right (Stein's risk)"));
+                                   "is still no worse than the input where the estimate is right (Stein's risk); 0 = by "
+                                   "passes: 2 with an albedo pass, 1 without"));
   }
   own.push_back(components_param());
   return own;
@@ -65,9 +66,16 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
 void edge_keeping_step_back(ParamTable& t) {
   for (ParamSpec& s : t)
     if (s.name == "step_back_noise") {
-      s.default_value = 2.0;
-      s.help += " (default 2 for this filter: its weights keep edges)";
+      s.default_value = 0.0;
+      s.help += " (default 0 for this filter: its weights keep edges, and texture's where an albedo pass says "
+                "where it is)";
     }
+}
+
+double step_back_noise_for(const ParamSet& params, const Frame& frame) {
+  const double k = params.get_float("step_back_noise");
+  if (k > 0) return k;
+  return frame.find(Role::Albedo) ? 2.0 : 1.0;
 }
 
 ParamSpec components_param() {

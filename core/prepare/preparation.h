@@ -38,12 +38,16 @@ constexpr double kDefaultFireflyK = 8.0;
 
 ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps);
 
-// The filters whose weights already keep edges (bilateral, atrous, pwaf) default to
-// step_back_noise = 2: their results are sound where the noise estimate runs low, and a
-// step back there only brings noise back (chosen on the tune scenes room and glossy at 1-64
-// spp, 1 / 1.5 / 2 / 3: better at each step for the three, worse for gaussian and guided,
-// whose blur crosses texture and is undone best by the estimate as it is; 2 is the cap).
+// The filters whose weights keep edges (bilateral, atrous, pwaf) default to step_back_noise
+// = 0, by passes: 2 with an albedo pass, whose weights and demodulation carry texture through,
+// so their results are sound where the noise estimate runs low and a step back there only
+// brings noise back (chosen on the tune scenes room and glossy at 1-64 spp, 1 / 1.5 / 2 / 3:
+// better at each step for the three, worse for gaussian and guided, whose blur crosses texture
+// and is undone best by the estimate as it is; 2 is the cap); 1 without one (the per-sample
+// scenes flattened to colour and depth: motion pwaf 0.052 with 1, 0.083 with 2).
 void edge_keeping_step_back(ParamTable& t);
+// step_back_noise as it applies to this frame (0: by passes, above).
+double step_back_noise_for(const ParamSet& params, const Frame& frame);
 
 // `components` (beauty | light_passes), in every filter's table so that every front end
 // takes it by the same name; the pipeline reads it (pipeline/components.h), no filter does.

@@ -99,6 +99,36 @@ TEST(StepBack, UpToTwiceTheNoiseABiasedFilterIsNoWorseThanTheInput) {
   }
 }
 
+// bilateral, atrous and pwaf take twice the estimate by default where an albedo pass carries
+// texture through, once without; the others once; a value given is kept. With an albedo pass
+// the filter's result is the oracle's blend at 2.
+TEST(StepBack, TwiceTheNoiseByDefaultOnlyForEdgeKeepingFiltersWithAnAlbedoPass) {
+  Image clean;
+  const Image noisy = scene(40, 30, 0.2, 9, &clean);
+  const Frame plain = testutil::colour_frame(noisy);
+  Frame with_albedo = plain;
+  testutil::add_pass(with_albedo, Role::Albedo, Image(40, 30, 3, 0.5f));
+  for (const std::string& name : image_filter_names()) {
+    auto f = make_filter(name);
+    if (f->info().temporal) continue;
+    SCOPED_TRACE(name);
+    const bool keeps = name == "bilateral" || name == "atrous" || name == "pwaf";
+    EXPECT_EQ(step_back_noise_for(f->params(), with_albedo), keeps ? 2.0 : 1.0);
+    EXPECT_EQ(step_back_noise_for(f->params(), plain), 1.0);
+    f->set("step_back_noise", 1.5);
+    EXPECT_EQ(step_back_noise_for(f->params(), with_albedo), 1.5);
+  }
+  auto on = make_filter("pwaf");
+  on->commit();
+  const Image a = on->execute(with_albedo);
+  auto off = make_filter("pwaf");
+  off->set("step_back", false);
+  off->commit();
+  Image expect = off->execute(with_albedo);
+  step_back(noisy, Roi::all(40, 30), 4, 0, expect, nullptr, 2.0);
+  EXPECT_EQ(a.storage(), expect.storage());
+}
+
 // A variance pass is each pixel's own, exact in expectation: it is not scaled.
 TEST(StepBack, AVariancePassIsNotScaled) {
   Image clean;
@@ -201,7 +231,7 @@ TEST(StepBack, EveryImageFilterTakesItByDefault) {
     off->commit();
     const Image b = off->execute(f);
     Image expect = b;
-    step_back(f.image(Role::Colour), Roi::all(40, 30), 4, 0, expect, nullptr, on->params().get_float("step_back_noise"));
+    step_back(f.image(Role::Colour), Roi::all(40, 30), 4, 0, expect, nullptr, step_back_noise_for(on->params(), f));
     EXPECT_EQ(a.storage(), expect.storage());
   }
 }
