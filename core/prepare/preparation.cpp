@@ -154,9 +154,7 @@ std::vector<std::string> preparation_unused(const ParamSet& params, const PrepSt
     report_unused(params, "albedo_prefilter_position", "with albedo_prefilter=0", notes);
   if (steps.demodulate && !params.get_bool("demodulate")) report_unused(params, "albedo_floor", "with demodulate=false", notes);
   if (steps.step_back && !params.get_bool("step_back"))
-    report_unused(params, "step_back_radius", "with step_back=false", notes);
-  if (steps.step_back && !params.get_bool("step_back"))
-    report_unused(params, "step_back_noise", "with step_back=false", notes);
+    for (const char* name : {"step_back_radius", "step_back_noise"}) report_unused(params, name, "with step_back=false", notes);
   return notes;
 }
 

@@ -138,12 +138,12 @@ const FilterInfo& PwafFilter::static_info() {
         ParamSpec::Int("outlier_radius", 3, 1, 8, "outlier statistics window half width"),
         ParamSpec::Int("variance_radius", 3, 1, 16, "half width of the window that clusters the variance (estimate or pass)"),
     });
+    edge_keeping_step_back(i.params);
     // Demodulated by default (chosen on room+glossy): pwaf has no albedo weight, and its
     // variance estimate counts texture edges as noise (high-pass residuals), so on a clean
     // render Gc let textures blur (glossy 64 spp: 0.0103 against the input's 0.0066; 0.0056
     // demodulated). Without an albedo pass the step is skipped with a note unless
     // demodulate=true was given (prepare/preparation.h).
-    edge_keeping_step_back(i.params);
     for (ParamSpec& s : i.params)
       if (s.name == "demodulate") {
         s.default_value = true;
