@@ -54,7 +54,7 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                  "half width of the window over which step_back weighs the result against the input"));
     own.push_back(ParamSpec::Float("step_back_noise", 1.0, 0.0, 2.0,
                                    "without a variance pass, step_back takes the image's noise estimate times this: "
-                                   "the estimate is right at a window's median but spreads (0.5-1.5x the truth), and a "
+                                   "the estimate is right at a window's median but spreads (about 0.5-1.5x the truth), and a "
                                    "window whose estimate runs low steps back from a sound result; up to 2 the blend "
                                    "is still no worse than the input where the estimate is right (Stein's risk); 0 = by "
                                    "passes: 2 with an albedo pass, 1 without"));
