@@ -55,14 +55,22 @@ SCENES = {
                           "and a glass sphere on a dark glossy turntable, lit by an outdoor HDRI "
                           "(Blender's courtyard studio light) and a strong sun; indirect clamp "
                           "off; with the light passes; held out: never used to choose settings."),
+    "fog": ("still", "Hazy warehouse bay inside homogeneous fog: sun shafts through four gaps in "
+                     "a brick wall, a spot lamp's visible cone on a checkered floor, cyan and "
+                     "magenta neon tubes, crates, a metal drum, a glossy ball (in-scattered light "
+                     "that no feature pass describes); held out: never used to choose settings."),
+    "fence": ("still", "A wire mesh fence (wires about half a pixel wide) before a cut-out hedge "
+                       "(Voronoi leaves over a Transparent BSDF) and a stucco wall, under a sun "
+                       "and a sky: every feature pass is aliased at the wires and leaf edges; "
+                       "held out: never used to choose settings."),
 }
-ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit"]
+ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
-         "chrome": "report", "orbit": "report"}
+         "chrome": "report", "orbit": "report", "fog": "report", "fence": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
-HALVES = {"sunlit": [16], "showroom": [16], "wall": [16]}
+HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16]}
 
 # Channel groups Blender writes (view layer "ViewLayer", compositing off).
 NOISY_PASSES = ["Combined", "Denoising Albedo", "Denoising Depth", "Denoising Normal", "Depth",
