@@ -272,10 +272,15 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   if (info_.steps.step_back && params_.get_bool("step_back") && step_back_applies()) {
     const Pass* variance = prepared_.frame->find(Role::Variance);
     const double k = step_back_noise_for(params_, *prepared_.frame);
+    const Image* modulation = step_back_modulation(params_, *prepared_.frame);
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
-                                       nthreads, out, variance ? &variance->image : nullptr, k);
+                                       nthreads, out, variance ? &variance->image : nullptr, k,
+                                       modulation);
     note(std::string("step_back") +
-         (variance ? " (noise from the variance pass)" : k != 1.0 ? " (noise estimate x" + rounded_text(k, 2) + ")" : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
+         (variance ? " (noise from the variance pass)"
+          : modulation || k != 1.0 ? std::string(" (noise estimate") + (modulation ? " on the illumination" : "") +
+                                         (k != 1.0 ? " x" + rounded_text(k, 2) : "") + ")"
+                                   : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
   prepared_.own = Frame{};  // the copied passes are not kept between frames

@@ -58,6 +58,11 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                    "window whose estimate runs low steps back from a sound result; up to 2 the blend "
                                    "is still no worse than the input where the estimate is right (Stein's risk); 0 = by "
                                    "passes: 2 with an albedo pass, 1 without"));
+    own.push_back(ParamSpec::Enum("step_back_estimate", "colour", {"colour", "illumination"},
+                                  "without a variance pass, where step_back estimates the noise: colour = the image "
+                                  "as it is; illumination = the colour divided by the albedo pass (then multiplied "
+                                  "back), so the texture the albedo explains is not read as noise (colour when the "
+                                  "render has no albedo pass)"));
   }
   own.push_back(components_param());
   return own;
@@ -69,6 +74,9 @@ void edge_keeping_step_back(ParamTable& t) {
       s.default_value = 0.0;
       s.help += " (default 0 for this filter: its weights keep edges, and texture's where an albedo pass says "
                 "where it is)";
+    } else if (s.name == "step_back_estimate") {
+      s.default_value = std::string("illumination");
+      s.help += " (default illumination for this filter, which keeps the texture an albedo pass shows)";
     }
 }
 
@@ -76,6 +84,12 @@ double step_back_noise_for(const ParamSet& params, const Frame& frame) {
   const double k = params.get_float("step_back_noise");
   if (k > 0) return k;
   return frame.find(Role::Albedo) ? 2.0 : 1.0;
+}
+
+const Image* step_back_modulation(const ParamSet& params, const Frame& frame) {
+  if (params.get_enum("step_back_estimate") != "illumination") return nullptr;
+  const Pass* a = frame.find(Role::Albedo);
+  return a ? &a->image : nullptr;
 }
 
 ParamSpec components_param() {

@@ -44,10 +44,16 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps);
 // brings noise back (chosen on the tune scenes room and glossy at 1-64 spp, 1 / 1.5 / 2 / 3:
 // better at each step for the three, worse for gaussian and guided, whose blur crosses texture
 // and is undone best by the estimate as it is; 2 is the cap); 1 without one (the per-sample
-// scenes flattened to colour and depth: motion pwaf 0.052 with 1, 0.083 with 2).
+// scenes flattened to colour and depth: motion pwaf 0.052 with 1, 0.083 with 2). They also
+// default to step_back_estimate = illumination: the noise estimated with the albedo divided
+// out, which reads a texture's edges as noise no more (chosen on room and glossy; box and
+// guided, whose blur crosses texture, were worse with it on the other stills).
 void edge_keeping_step_back(ParamTable& t);
 // step_back_noise as it applies to this frame (0: by passes, above).
 double step_back_noise_for(const ParamSet& params, const Frame& frame);
+// The albedo the step back estimates the noise under (step_back_estimate = illumination and
+// the frame has an albedo pass), else null.
+const Image* step_back_modulation(const ParamSet& params, const Frame& frame);
 
 // `components` (beauty | light_passes), in every filter's table so that every front end
 // takes it by the same name; the pipeline reads it (pipeline/components.h), no filter does.

@@ -43,7 +43,11 @@ struct StepBackStats {
 // noise_scale: without a variance pass, the image's noise estimate is multiplied by it (at most
 // 2: the blend of a biased result then still keeps the input's risk where the estimate is right;
 // above 1 a sound filter keeps its result where the estimate runs low; see below).
+// modulation: the albedo pass, or null: without a variance pass the noise is then estimated on
+// colour / albedo (the albedo clamped to [0.01, 1], non-finite read as 1) and scaled back by
+// albedo^2 per channel, so texture the albedo explains is not read as noise.
 StepBackStats step_back(const Image& input, const Roi& roi, int radius, int nthreads, Image& out,
-                        const Image* variance = nullptr, double noise_scale = 1.0);
+                        const Image* variance = nullptr, double noise_scale = 1.0,
+                        const Image* modulation = nullptr);
 
 }  // namespace mcr

@@ -100,8 +100,9 @@ TEST(StepBack, UpToTwiceTheNoiseABiasedFilterIsNoWorseThanTheInput) {
 }
 
 // bilateral, atrous and pwaf take twice the estimate by default where an albedo pass carries
-// texture through, once without; the others once; a value given is kept. With an albedo pass
-// the filter's result is the oracle's blend at 2.
+// texture through, once without, and estimate it on the illumination; the others once, on the
+// colour; a value given is kept. With an albedo pass the filter's result is the oracle's blend
+// at 2 on the illumination.
 TEST(StepBack, TwiceTheNoiseByDefaultOnlyForEdgeKeepingFiltersWithAnAlbedoPass) {
   Image clean;
   const Image noisy = scene(40, 30, 0.2, 9, &clean);
@@ -115,8 +116,13 @@ TEST(StepBack, TwiceTheNoiseByDefaultOnlyForEdgeKeepingFiltersWithAnAlbedoPass) 
     const bool keeps = name == "bilateral" || name == "atrous" || name == "pwaf";
     EXPECT_EQ(step_back_noise_for(f->params(), with_albedo), keeps ? 2.0 : 1.0);
     EXPECT_EQ(step_back_noise_for(f->params(), plain), 1.0);
+    // ... and estimate the noise on the illumination where an albedo pass exists.
+    EXPECT_EQ(step_back_modulation(f->params(), with_albedo), keeps ? &with_albedo.image(Role::Albedo) : nullptr);
+    EXPECT_EQ(step_back_modulation(f->params(), plain), nullptr);
     f->set("step_back_noise", 1.5);
     EXPECT_EQ(step_back_noise_for(f->params(), with_albedo), 1.5);
+    f->set("step_back_estimate", std::string(keeps ? "colour" : "illumination"));
+    EXPECT_EQ(step_back_modulation(f->params(), with_albedo), keeps ? nullptr : &with_albedo.image(Role::Albedo));
   }
   auto on = make_filter("pwaf");
   on->commit();
@@ -125,8 +131,34 @@ TEST(StepBack, TwiceTheNoiseByDefaultOnlyForEdgeKeepingFiltersWithAnAlbedoPass) 
   off->set("step_back", false);
   off->commit();
   Image expect = off->execute(with_albedo);
-  step_back(noisy, Roi::all(40, 30), 4, 0, expect, nullptr, 2.0);
+  step_back(noisy, Roi::all(40, 30), 4, 0, expect, nullptr, 2.0, &with_albedo.image(Role::Albedo));
   EXPECT_EQ(a.storage(), expect.storage());
+}
+
+// Thin albedo stripes (one pixel in three) under smooth light, noise 1%: each stripe is a
+// peak, which the colour's noise estimate reads as noise; divided by the albedo it is flat.
+// A blurred result must then be stepped back from nearly everywhere (the input is almost the
+// truth), which only the estimate on the illumination does.
+TEST(StepBack, TextureTheAlbedoExplainsIsNotReadAsNoise) {
+  const int w = 72, h = 54;
+  std::mt19937 rng(11);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  Image albedo(w, h, 3), clean(w, h, 3), noisy(w, h, 3);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        albedo.at(x, y, c) = x % 3 == 0 ? 0.8f : 0.2f;
+        clean.at(x, y, c) = albedo.at(x, y, c) * (0.5f + 0.01f * float(x + y));
+        noisy.at(x, y, c) = clean.at(x, y, c) * (1.0f + 0.01f * noise(rng));
+      }
+  const Image blurred = box_blur(noisy, 2);
+  Image on_colour = blurred, on_light = blurred;
+  const StepBackStats sc = step_back(noisy, Roi::all(w, h), 4, 2, on_colour);
+  const StepBackStats sl = step_back(noisy, Roi::all(w, h), 4, 2, on_light, nullptr, 1.0, &albedo);
+  EXPECT_LT(relmse(on_light, clean), 2.0 * relmse(noisy, clean));
+  EXPECT_LT(relmse(on_light, clean), 0.1 * relmse(on_colour, clean));
+  EXPECT_LT(sl.mean_weight, 0.1);
+  EXPECT_GT(sc.mean_weight, 0.3);
 }
 
 // A variance pass is each pixel's own, exact in expectation: it is not scaled.
