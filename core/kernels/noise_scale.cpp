@@ -16,6 +16,7 @@ constexpr double kRelativeEps = 1e-3;  // luminance^2 below which noise counts a
 constexpr double kChi2MedianToMean = 1.27;
 constexpr double kFloorRelative = 0.02;
 constexpr double kRareOutliers = 0.03;  // share of a tile's pixels
+constexpr float kAlbedoFloor = 0.01f;   // as the demodulation's (prepare/demodulation.h)
 
 // The frame's RGB at (x, y) and whether it is finite.
 struct Rgb {
@@ -109,11 +110,20 @@ double NoiseScales::robust(std::size_t i, int c) const {
 }
 
 double NoiseScales::variance_of(std::size_t i, int c) const {
-  const double m = median[i * 3 + std::size_t(c)];
-  return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(&median[i * 3]) + kRelativeEps);
+  if (albedo.empty()) {
+    const double m = median[i * 3 + std::size_t(c)];
+    return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(&median[i * 3]) + kRelativeEps);
+  }
+  // The illumination's variance shared among the channels as its median (the colour's over the
+  // pixel's albedo) is, then scaled back by the albedo^2.
+  float flat[3];
+  for (int k = 0; k < 3; ++k) flat[k] = median[i * 3 + std::size_t(k)] / albedo[i * 3 + std::size_t(k)];
+  const double a = albedo[i * 3 + std::size_t(c)], m = flat[c];
+  return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(flat) + kRelativeEps) * a * a;
 }
 
-NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads, const Image* vpass) {
+NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads, const Image* vpass,
+                                  const Image* modulation) {
   const int W = colour.width(), H = colour.height();
   NoiseScales s;
   s.box = box_in.clipped(W, H);
@@ -121,6 +131,16 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   const Rgb y{colour};
   const bool use_pass = vpass && vpass->width() == W && vpass->height() == H && vpass->channels() > 0;
   auto pass_at = [&](int x, int yy) { return pass_variance(*vpass, x, yy); };
+  const bool demod = !use_pass && modulation && modulation->width() == W && modulation->height() == H &&
+                     modulation->channels() >= 3;
+  auto albedo_at = [&](int x, int yy, int c) {
+    const float a = modulation->pixel(x, yy)[c];
+    return std::isfinite(a) ? std::min(std::max(a, kAlbedoFloor), 1.0f) : 1.0f;
+  };
+  // The value the variance's products read: the colour, or the illumination.
+  auto value = [&](const float* p, int x, int yy, int c) {
+    return demod ? double(p[c]) / albedo_at(x, yy, c) : double(p[c]);
+  };
   const std::size_t n = std::size_t(s.box.width()) * std::size_t(s.box.height());
   s.variance.assign(n, 0.0f);
   s.relative.assign(n, 0.0f);
@@ -129,6 +149,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   s.outlier.assign(n, 0);
   s.excess.assign(n, 0.0f);
   s.detail.assign(n, 0);
+  if (demod) s.albedo.assign(n * 3, 1.0f);
 
   // Region T: the tiles' windows. Medians and residual energies are needed there.
   const Roi T = s.box.grown(kTileGrow + kTile, W, H);
@@ -305,7 +326,10 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
         if (!calm(ax, ay) || !calm(bx, by)) continue;
         const float* a = y.at(ax, ay);
         const float* b = y.at(bx, by);
-        for (int c = 0; c < 3; ++c) sum += (double(p[c]) - a[c]) * (double(p[c]) - b[c]);
+        for (int c = 0; c < 3; ++c) {
+          const double v = value(p, x, yy, c);
+          sum += (v - value(a, ax, ay, c)) * (v - value(b, bx, by, c));
+        }
         ++cnt;
       }
       if (cnt) z.set(x - V.x0, yy - V.y0, sum / (3.0 * cnt) / level(x, yy), 1.0);
@@ -320,6 +344,8 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       s.finite[o] = 1;
       const std::size_t i = std::size_t(yy - T.y0) * std::size_t(tw) + std::size_t(x - T.x0);
       for (int c = 0; c < 3; ++c) s.median[o * 3 + std::size_t(c)] = med[i * 3 + std::size_t(c)];
+      if (demod)
+        for (int c = 0; c < 3; ++c) s.albedo[o * 3 + std::size_t(c)] = albedo_at(x, yy, c);
       s.relative[o] = tile_of(x, yy);
       const float e = exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
       s.excess[o] = e;

@@ -60,6 +60,8 @@ struct NoiseScales {
   double robust(std::size_t i, int c) const;
   double robust(std::size_t i) const { return (robust(i, 0) + robust(i, 1) + robust(i, 2)) / 3.0; }
   double variance_of(std::size_t i, int c) const;
+  // With a modulation (below): each pixel's albedo per channel, clamped; else empty.
+  std::vector<float> albedo;
 };
 
 constexpr double kOutlierSigmas = 4.0;  // outlier: further than this many robust deviations
@@ -71,7 +73,13 @@ constexpr double kRelMseEps = 0.01;     // relMSE's denominator term, (x - r)^2 
 // is given, finite and >= 0, `variance` comes from it instead of the estimate from the
 // image (exact in expectation, no signal in it): its mean over the channels, averaged over
 // the same window relative to each pixel's level and scaled back to the pixel's (.cpp).
-NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads, const Image* variance = nullptr);
+// modulation: an albedo pass, or null. Without a variance pass `variance` is then estimated on
+// the illumination, colour / albedo (the albedo clamped to [0.01, 1], non-finite read as 1),
+// and variance_of scales it back by the pixel's albedo^2: texture the albedo explains (a thin
+// mortar line, an anti-aliased checker edge) is a peak the colour's products read as noise.
+// The medians, scales and outliers stay the colour's.
+NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthreads, const Image* variance = nullptr,
+                                  const Image* modulation = nullptr);
 
 // detail(p) above for one pixel, without the rest of the estimate (the firefly clamp's keep
 // mask): false where the pass or the pixel is not finite, or it has no finite neighbour.

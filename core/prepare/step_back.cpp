@@ -13,7 +13,6 @@ namespace mcr {
 namespace {
 
 constexpr double kRangeSigmas = 2.0;    // how far the blend may leave the 3x3 input range
-constexpr double kAlbedoFloor = 0.01;   // the demodulation's (prepare/demodulation.h default)
 constexpr float kMax = 3.402823466e38f;
 
 double clamp_float(double v) { return std::min(std::max(v, -double(kMax)), double(kMax)); }
@@ -28,30 +27,7 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
   const int W = input.width(), H = input.height();
   const Roi roi = roi_in.clipped(W, H);
   if (roi.empty()) return st;
-  const NoiseScales ns = estimate_noise_scales(input, roi, nthreads, variance);
-  // The estimate on the illumination (colour / albedo, scaled back by albedo^2): texture the
-  // albedo explains (a checker's edge, mortar lines) is not read as noise there. A crop grown
-  // by 16 (the estimate reads up to 12 around) and starting on the estimate's 8-pixel tile grid
-  // gives the roi the same values as the whole frame would (a band of a tiled run too).
-  const bool demod = modulation && !variance && modulation->width() == W && modulation->height() == H &&
-                     modulation->channels() >= 3;
-  auto albedo = [&](int x, int y, int c) {
-    const float a = modulation->pixel(x, y)[c];
-    return std::isfinite(a) ? std::min(std::max(double(a), kAlbedoFloor), 1.0) : 1.0;
-  };
-  const Roi grown = roi.grown(16, W, H);
-  const Roi crop{grown.x0 - grown.x0 % 8, grown.y0 - grown.y0 % 8, grown.x1, grown.y1};
-  NoiseScales flat_ns;
-  if (demod) {
-    Image flat(crop.width(), crop.height(), 3);
-    parallel_rows(crop.y0, crop.y1, nthreads, [&](int y) {
-      for (int x = crop.x0; x < crop.x1; ++x)
-        for (int c = 0; c < 3; ++c)
-          flat.pixel(x - crop.x0, y - crop.y0)[c] = float(double(input.pixel(x, y)[c]) / albedo(x, y, c));
-    });
-    flat_ns = estimate_noise_scales(
-        flat, Roi{roi.x0 - crop.x0, roi.y0 - crop.y0, roi.x1 - crop.x0, roi.y1 - crop.y0}, nthreads, nullptr);
-  }
+  const NoiseScales ns = estimate_noise_scales(input, roi, nthreads, variance, modulation);
   const int rw = roi.width(), rh = roi.height();
 
   // The window sums of the blend weight's numerator and denominator, over the roi only
@@ -74,9 +50,7 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
       for (int c = 0; c < 3; ++c) {
         const double w = 1.0 / (double(m[c]) * m[c] + kRelMseEps);
         const double d = double(f[c]) - double(p[c]);
-        const double a = demod ? albedo(x, y, c) : 1.0;
-        nv += w * scale * a * a *
-              (demod ? flat_ns.variance_of(flat_ns.at(x - crop.x0, y - crop.y0), c) : ns.variance_of(i, c));
+        nv += w * scale * ns.variance_of(i, c);
         dv += w * d * d;
       }
       num.set(x - roi.x0, y - roi.y0, nv);

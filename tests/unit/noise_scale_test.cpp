@@ -73,6 +73,43 @@ TEST(NoiseScale, EdgesOfANoiseFreeImageAreNotNoise) {
   EXPECT_EQ(std::count(s.outlier.begin(), s.outlier.end(), 1), 0);
 }
 
+// Thin stripes of albedo (one pixel in three) times smooth light, noise relative to the level:
+// on the colour each stripe is a peak the products read as noise; divided by the albedo the
+// image is smooth, and the estimate scaled back by the albedo^2 is each pixel's noise.
+TEST(NoiseScale, OnTheIlluminationTextureIsNotNoise) {
+  const int w = 96, h = 72;
+  const double rel = 0.05;
+  std::mt19937 rng(5);
+  std::normal_distribution<float> noise(0.0f, 1.0f);
+  Image albedo(w, h, 3), im(w, h, 3);
+  double truth = 0;
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) {
+        albedo.at(x, y, c) = x % 3 == 0 ? 0.9f : 0.15f + 0.05f * float(c);
+        const double clean = albedo.at(x, y, c) * (0.6 + 0.005 * (x + y));
+        im.at(x, y, c) = float(clean * (1.0 + rel * noise(rng)));
+        truth += std::pow(rel * clean, 2);
+      }
+  truth /= double(w) * h * 3;
+  auto mean_variance = [&](const NoiseScales& s) {
+    double sum = 0;
+    for (std::size_t i = 0; i < s.variance.size(); ++i)
+      for (int c = 0; c < 3; ++c) sum += s.variance_of(i, c);
+    return sum / double(s.variance.size() * 3);
+  };
+  const NoiseScales on_colour = estimate_noise_scales(im, Roi::all(w, h), 2);
+  const NoiseScales on_light = estimate_noise_scales(im, Roi::all(w, h), 2, nullptr, &albedo);
+  EXPECT_GT(mean_variance(on_colour), 10.0 * truth);
+  EXPECT_NEAR(mean_variance(on_light) / truth, 1.0, 0.25);
+  // The medians, scales and outliers stay the colour's.
+  EXPECT_EQ(on_light.median, on_colour.median);
+  EXPECT_EQ(on_light.outlier, on_colour.outlier);
+  // A variance pass wins over the modulation.
+  const Image pass(w, h, 3, float(truth));
+  EXPECT_TRUE(estimate_noise_scales(im, Roi::all(w, h), 2, &pass, &albedo).albedo.empty());
+}
+
 TEST(NoiseScale, FireflyIsAnOutlierAndDoesNotInflateTheRobustScale) {
   Image im = blocks(64, 64, 3, 0.05);
   for (auto [x, y] : {std::pair{20, 20}, std::pair{22, 21}, std::pair{40, 9}})
