@@ -211,14 +211,19 @@ def principled(name, color=(0.8, 0.8, 0.8), roughness=0.5, metallic=0.0, specula
     return mat
 
 
-def single_bsdf(name, node_type, inputs):
-    """A material of one GGX BSDF node (node_type) into the output; inputs: {socket: value}."""
+def bare_material(name):
+    """A node material with nothing but its output node: (material, node tree, output)."""
     mat = bpy.data.materials.new(name)
     mat.use_nodes = True
     nt = mat.node_tree
     for n in list(nt.nodes):
         nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    return mat, nt, nt.nodes.new("ShaderNodeOutputMaterial")
+
+
+def single_bsdf(name, node_type, inputs):
+    """A material of one GGX BSDF node (node_type) into the output; inputs: {socket: value}."""
+    mat, nt, out = bare_material(name)
     node = nt.nodes.new(node_type)
     node.distribution = "GGX"
     for socket, value in inputs.items():
@@ -242,12 +247,7 @@ def glass(name, ior=1.5, color=None):
 
 def emitter(name, color=(1.0, 1.0, 1.0), strength=10.0):
     """Pure emission material (for window-like emitters)."""
-    mat = bpy.data.materials.new(name)
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    mat, nt, out = bare_material(name)
     em = nt.nodes.new("ShaderNodeEmission")
     em.inputs["Color"].default_value = (*color, 1.0)
     em.inputs["Strength"].default_value = strength

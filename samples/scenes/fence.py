@@ -14,20 +14,13 @@ import math
 import os
 import sys
 
-import bpy
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import common as C  # noqa: E402
 
 
 def leaf_material():
     """Green leaves where a Voronoi distance is small, transparent holes elsewhere."""
-    mat = bpy.data.materials.new("hedge_leaves")
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    mat, nt, out = C.bare_material("hedge_leaves")
     tc = nt.nodes.new("ShaderNodeTexCoord")
     vor = nt.nodes.new("ShaderNodeTexVoronoi")
     vor.feature = "F1"

@@ -27,12 +27,7 @@ DENSITY = 0.05
 
 
 def fog_material():
-    mat = bpy.data.materials.new("fog")
-    mat.use_nodes = True
-    nt = mat.node_tree
-    for n in list(nt.nodes):
-        nt.nodes.remove(n)
-    out = nt.nodes.new("ShaderNodeOutputMaterial")
+    mat, nt, out = C.bare_material("fog")
     vol = nt.nodes.new("ShaderNodeVolumePrincipled")
     vol.inputs["Color"].default_value = (0.85, 0.87, 0.9, 1.0)
     vol.inputs["Density"].default_value = DENSITY
