@@ -236,6 +236,14 @@ Roi checked_roi(const Roi& r, int w, int h) {
   return r;
 }
 
+// Where the step back's noise came from, for its note ("" for the plain image estimate).
+std::string noise_source(bool variance_pass, bool on_illumination, double k) {
+  if (variance_pass) return " (noise from the variance pass)";
+  if (!on_illumination && k == 1.0) return "";
+  return std::string(" (noise estimate") + (on_illumination ? " on the illumination" : "") +
+         (k != 1.0 ? " x" + rounded_text(k, 2) : "") + ")";
+}
+
 }  // namespace
 
 Image Filter::execute(const Frame& frame, const ExecOptions& options) {
@@ -276,11 +284,8 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
                                        nthreads, out, variance ? &variance->image : nullptr, k,
                                        modulation);
-    note(std::string("step_back") +
-         (variance ? " (noise from the variance pass)"
-          : modulation || k != 1.0 ? std::string(" (noise estimate") + (modulation ? " on the illumination" : "") +
-                                         (k != 1.0 ? " x" + rounded_text(k, 2) : "") + ")"
-                                   : "") + ": mean weight of the filtered result " + rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
+    note("step_back" + noise_source(variance != nullptr, modulation != nullptr, k) + ": mean weight of the filtered result " +
+         rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
   prepared_.own = Frame{};  // the copied passes are not kept between frames

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/albedo_divisor.h"
 #include "kernels/window_sums.h"
 #include "util/parallel.h"
 
@@ -16,7 +17,6 @@ constexpr double kRelativeEps = 1e-3;  // luminance^2 below which noise counts a
 constexpr double kChi2MedianToMean = 1.27;
 constexpr double kFloorRelative = 0.02;
 constexpr double kRareOutliers = 0.03;  // share of a tile's pixels
-constexpr float kAlbedoFloor = 0.01f;   // as the demodulation's (prepare/demodulation.h)
 
 // The frame's RGB at (x, y) and whether it is finite.
 struct Rgb {
@@ -133,10 +133,7 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   auto pass_at = [&](int x, int yy) { return pass_variance(*vpass, x, yy); };
   const bool demod = !use_pass && modulation && modulation->width() == W && modulation->height() == H &&
                      modulation->channels() >= 3;
-  auto albedo_at = [&](int x, int yy, int c) {
-    const float a = modulation->pixel(x, yy)[c];
-    return std::isfinite(a) ? std::min(std::max(a, kAlbedoFloor), 1.0f) : 1.0f;
-  };
+  auto albedo_at = [&](int x, int yy, int c) { return demodulation_albedo(modulation->pixel(x, yy)[c], float(kDefaultAlbedoFloor)); };
   // The value the variance's products read: the colour, or the illumination.
   auto value = [&](const float* p, int x, int yy, int c) {
     return demod ? double(p[c]) / albedo_at(x, yy, c) : double(p[c]);

@@ -74,7 +74,8 @@ constexpr double kRelMseEps = 0.01;     // relMSE's denominator term, (x - r)^2 
 // image (exact in expectation, no signal in it): its mean over the channels, averaged over
 // the same window relative to each pixel's level and scaled back to the pixel's (.cpp).
 // modulation: an albedo pass, or null. Without a variance pass `variance` is then estimated on
-// the illumination, colour / albedo (the albedo clamped to [0.01, 1], non-finite read as 1),
+// the illumination, colour / albedo (the demodulation's albedo, kernels/albedo_divisor.h, at the
+// default floor: clamped to [0.01, 1], non-finite read as 1),
 // and variance_of scales it back by the pixel's albedo^2: texture the albedo explains (a thin
 // mortar line, an anti-aliased checker edge) is a peak the colour's products read as noise.
 // The medians, scales and outliers stay the colour's.

@@ -17,25 +17,10 @@
 // The second line keeps colour / a within 2^126, so a finite colour near FLT_MAX over a dark albedo does not
 // overflow to inf (and come back as 0); it never acts below |colour| = 2^126 * a (8.5e37 a),
 // so ordinary images are divided by the albedo as they always were.
-#include <algorithm>
-#include <cmath>
-
 #include "image/image.h"
+#include "kernels/albedo_divisor.h"
 
 namespace mcr {
-
-constexpr float kAlbedoCeiling = 1.0f;
-
-inline float demodulation_albedo(float v, float floor, float ceiling = kAlbedoCeiling) {
-  return (v - v == 0.0f) ? std::min(std::max(v, floor), ceiling) : 1.0f;
-}
-
-// The divisor of one colour value c over albedo v (the rule above). 2^-126 is FLT_MIN, a
-// normal float (no flush-to-zero concern), and |c| * 2^-126 is exact where it matters.
-inline float demodulation_divisor(float v, float c, float floor, float ceiling = kAlbedoCeiling) {
-  const float need = (c - c == 0.0f) ? std::fabs(c) * 0x1p-126f : 0.0f;
-  return std::max(demodulation_albedo(v, floor, ceiling), need);
-}
 
 // One row of n pixels: al = the divisor per channel (an albedo of fewer than 3 channels
 // repeats its last one), il = colour / al. colour, al and il are RGB.

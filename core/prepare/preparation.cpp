@@ -16,7 +16,7 @@ namespace mcr {
 ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
   if (steps.demodulate) {
     own.push_back(ParamSpec::Bool("demodulate", false, "divide the colour by the albedo pass before filtering and multiply after"));
-    own.push_back(ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0,
+    own.push_back(ParamSpec::Float("albedo_floor", kDefaultAlbedoFloor, 1e-6, 1.0,
                                    "albedo is raised to at least albedo_floor for demodulation and capped at 1 (an albedo above 1 "
                                    "holds light: Blender's follows a mirror's bounce to a lamp)"));
   }

@@ -107,7 +107,7 @@ const FilterInfo& BmfrFilter::static_info() {
                         "fit illumination = colour / max(albedo, albedo_floor) and multiply back before TAA (when an albedo "
                         "pass exists); pixels whose albedo exceeds 1 (it holds light) are left out of the fit, mirror-like "
                         "ones are not divided"),
-        ParamSpec::Float("albedo_floor", 0.01, 1e-6, 1.0,
+        ParamSpec::Float("albedo_floor", kDefaultAlbedoFloor, 1e-6, 1.0,
                          "albedo_demodulation raises the albedo to at least this"),
         ParamSpec::Enum("position_test", "relative", {"relative", "absolute"},
                         "history discard by world distance: relative = in pixel footprints, absolute = world units"),
