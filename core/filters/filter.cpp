@@ -155,6 +155,9 @@ void Filter::begin_statistics() {
   stats_pass_ = 0;
   drop_own_statistics();
   stats_state_ = StatsState::Measuring;
+  // A band cannot see the frame's level: a first pass over every band measures it.
+  exposure_measuring_ = exposure_applies() && !exposure_pinned_;
+  exposure_level_ = ExposureLevel{};
 }
 
 void Filter::measure(const Frame& band, const Roi& rows, int nthreads) {
@@ -165,7 +168,11 @@ void Filter::measure(const Frame& band, const Roi& rows, int nthreads) {
   notes_.clear();
   const Roi r = rows.clipped(band.width, band.height);
   if (r.empty()) return;
-  prepare(band, params_, info_.steps, reads(r, band.width, band.height), nthreads, prepared_);
+  if (exposure_measuring_) {
+    exposure_level_.add(band.image(Role::Colour), r, nthreads);
+    return;
+  }
+  prepare(band, params_, info_.steps, reads(r, band.width, band.height), nthreads, prepared_, exposure_);
   if (stats_pass_ == 0) {  // the first pass: the holes and every pass's spread
     measured_holes_ += prepared_.holes;
     for (const Pass& p : prepared_.frame->passes) {
@@ -193,6 +200,12 @@ void Filter::run_to_measure(const Frame& band, const Image& colour, const Roi& r
 
 bool Filter::end_statistics_pass() {
   if (stats_state_ != StatsState::Measuring) throw Error(Errc::Internal, "filter '" + info_.name + "': end_statistics_pass() without begin");
+  if (exposure_measuring_) {  // the exposure's pass: the statistics' own passes follow at its scale
+    exposure_measuring_ = false;
+    exposure_ = mcr::exposure_scale(exposure_level_);
+    exposure_pinned_ = exposure_from_stats_ = true;
+    return true;
+  }
   if (stats_pass_ == 0) {
     for (auto& [name, range] : measuring_ranges_) ranges_.emplace_back(name, std::make_shared<const WholeFrameRange>(range));
     measuring_ranges_.clear();
@@ -218,6 +231,31 @@ void Filter::drop_statistics() {
   drop_own_statistics();
   stats_state_ = StatsState::None;
   stats_pass_ = 0;
+  exposure_measuring_ = false;
+  if (exposure_from_stats_) exposure_pinned_ = exposure_from_stats_ = false;
+}
+
+void Filter::reset() {
+  if (!exposure_from_stats_) exposure_pinned_ = false;
+  reset_history();
+}
+
+void Filter::pin_exposure(double k) {
+  exposure_ = k;
+  exposure_pinned_ = true;
+  exposure_from_stats_ = false;
+}
+
+bool Filter::exposure_applies() const { return info_.steps.exposure && params_.get_enum("exposure") == "auto"; }
+
+double Filter::exposure_for(const Image& colour, int nthreads) {
+  if (!exposure_applies()) return exposure_ = 1.0;
+  if (exposure_pinned_) return exposure_;
+  ExposureLevel level;
+  level.add(colour, Roi::all(colour.width(), colour.height()), nthreads);
+  exposure_ = mcr::exposure_scale(level);
+  if (info_.temporal) exposure_pinned_ = true;  // its history is at this scale
+  return exposure_;
 }
 
 namespace {
@@ -262,7 +300,12 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     return out;
   }
 
-  prepare(frame, params_, info_.steps, reads(roi, w, h), nthreads, prepared_);
+  const double k = exposure_for(input, nthreads);
+  prepare(frame, params_, info_.steps, reads(roi, w, h), nthreads, prepared_, k);
+  if (k != 1.0)
+    note("exposure: filtered at " + rounded_text(k, 3) + "x the render's (its mean luminance " +
+         rounded_text(exposure_level_of(input, nthreads), 3) + " lies outside [" + rounded_text(kExposureLow, 2) + ", " +
+         rounded_text(kExposureHigh, 2) + "]), scaled back");
   for (std::string& n : prepared_.notes) notes_.push_back(std::move(n));
 
   Image out;
@@ -288,6 +331,8 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
          rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
+  // Back to the render's exposure; outside the roi finish() kept the input bit for bit.
+  unscale_exposure(out, roi, k, nthreads);
   prepared_.own = Frame{};  // the copied passes are not kept between frames
   prepared_.colour = Image{};
   return out;

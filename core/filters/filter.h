@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "image/pass.h"
+#include "prepare/exposure.h"
 #include "prepare/preparation.h"
 #include "util/params.h"
 
@@ -69,8 +70,17 @@ class Filter {
   // Throws MissingPass naming the passes the frame lacks, before any work.
   Image execute(const Frame& frame, const ExecOptions& options = {});
 
-  // Drops temporal history (new shot, frames out of order).
-  virtual void reset() {}
+  // Drops temporal history (new shot, frames out of order), and a temporal filter's exposure.
+  void reset();
+
+  // The exposure step (prepare/exposure.h) at a fixed factor k instead of the frame's own:
+  // `auto` runs its candidates at 1 on the frame it scaled (a sample tile's level is not the
+  // frame's). A temporal filter pins the first frame's until reset(): its history is at that
+  // scale. Without the step (exposure=off, or a filter that does not take it) no effect.
+  void pin_exposure(double k);
+  // Whether the exposure step may scale a frame (then it copies the passes it reads: the
+  // memory a tiled run plans for).
+  bool exposure_may_scale() const { return exposure_applies(); }
 
   // With light passes (pipeline/components.h): whether it divides each component by its
   // colour pass (the albedo it is given) itself and multiplies back before work that must
@@ -126,6 +136,11 @@ class Filter {
 
  protected:
   virtual void check_params() {}
+  // What reset() drops besides the exposure (a temporal filter's history).
+  virtual void reset_history() {}
+  // During run(): the factor the exposure step scaled the frame by (1: not scaled). A setting
+  // in the render's colour units (an absolute colour sigma) is multiplied by it.
+  double exposure_scale() const { return exposure_; }
   // The filter's own needs under params_ (default: info().required, plus the feature
   // block's use_<f>=on; info().optional less the use_<f>=off ones).
   virtual PassNeeds own_needs() const;
@@ -191,6 +206,13 @@ class Filter {
   std::size_t measured_holes_ = 0;
   int stats_pass_ = 0;
   bool measuring_run_ = false;
+  // The exposure step: the factor of the current run; pinned (by pin_exposure(), a temporal
+  // filter's first frame, or a tiled run's first statistics pass, which measures it).
+  double exposure_ = 1.0;
+  bool exposure_pinned_ = false, exposure_from_stats_ = false, exposure_measuring_ = false;
+  ExposureLevel exposure_level_;
+  bool exposure_applies() const;
+  double exposure_for(const Image& colour, int nthreads);
 };
 
 }  // namespace mcr

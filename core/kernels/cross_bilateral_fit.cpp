@@ -55,7 +55,7 @@ int cross_bilateral_fit_reach(const ParamSet& params) {
 
 void cross_bilateral_fit(const Frame& frame, const Image& colour, const ParamSet& params, const std::string& owner,
                          const Roi& roi, Image& out, int nthreads, const std::function<void(std::string)>& note,
-                         CrossBilateralScratch& s) {
+                         CrossBilateralScratch& s, double colour_units) {
   const int w = frame.width, h = frame.height;
   const Foveation fov(params, w, h);
   const int fixed = int(params.get_int("radius"));
@@ -123,7 +123,9 @@ void cross_bilateral_fit(const Frame& frame, const Image& colour, const ParamSet
   pass.colour_ok = cp.ok.data();
   pass.valid = valid.data();
   set_colour_weight(pass, guides, params, frame, colour, nthreads, s.noise_a);
-  pass.colour_amul = 1.0f / cp.scale;  // the colour planes are scaled
+  // The colour planes are scaled; an absolute sigma is in the render's units.
+  const double units = params.get_enum("colour_weight") == "noise" ? 1.0 : colour_units;
+  pass.colour_amul = float(1.0 / (double(cp.scale) * units));
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
   pass.s = sc.empty() ? nullptr : sc.data();
   pass.s_const = coef(spatial.inner);

@@ -39,9 +39,11 @@ struct CrossBilateralScratch {
 int cross_bilateral_fit_reach(const ParamSet& params);
 
 // Writes out inside roi; `params` holds cross_bilateral_fit_params() (and may hold more),
-// `owner` names the filter in errors; note() receives dropped-weight notes.
+// `owner` names the filter in errors; note() receives dropped-weight notes. colour_units: the
+// factor the colour was scaled by since an absolute colour_sigma was given in its units (the
+// exposure step, prepare/exposure.h); a noise-relative weight needs none.
 void cross_bilateral_fit(const Frame& frame, const Image& colour, const ParamSet& params, const std::string& owner,
                          const Roi& roi, Image& out, int nthreads, const std::function<void(std::string)>& note,
-                         CrossBilateralScratch& scratch);
+                         CrossBilateralScratch& scratch, double colour_units = 1.0);
 
 }  // namespace mcr

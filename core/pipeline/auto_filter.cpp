@@ -344,12 +344,14 @@ const FilterInfo& AutoFilter::static_info() {
         ParamSpec::Float("min_gain", 0.05, 0.0, 1.0,
                          "a candidate must be estimated to cut the input's relMSE by this share, else the input is "
                          "kept as it is"),
+        exposure_param(),
         components_param(),
     };
     i.required = {Role::Colour};
     i.optional = {Role::Normal,   Role::Position,       Role::Albedo,       Role::Depth,       Role::Variance,
                   Role::SampleCount, Role::SecondPosition, Role::SecondNormal};
     i.steps = PrepSteps::none();
+    i.steps.exposure = true;  // the candidates run at 1 on the frame it scaled
     i.nonfinite_policy = "as the filter it runs; a copied input has its non-finite values replaced by 0; non-finite "
                          "pixels take no part in the scores";
     return i;
@@ -375,6 +377,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       continue;
     }
     f->commit();
+    f->pin_exposure(1.0);  // the frame is at the scale auto's exposure step chose; a tile's level is not the frame's
     cands.push_back(std::move(f));
   }
   if (!skipped.empty()) note("auto: candidates skipped: " + skipped);

@@ -48,7 +48,9 @@ int band_rows_for(const Filter& filter, int width, int height, int input_channel
   constexpr double kMeasureShare = 0.6;
   constexpr double kProcess = 160.0 * 1024 * 1024;  // the process itself (code, libraries, thread stacks)
   const double whole = kProcess + px * (12.0 + 4.0);
-  const double per_row = double(width) * (4.0 * input_channels + filter.band_work_bytes());  // the passes read, the planes
+  // The passes read (twice where the exposure step may copy them to scale), the planes.
+  const double passes = (filter.exposure_may_scale() ? 8.0 : 4.0) * input_channels;
+  const double per_row = double(width) * (passes + filter.band_work_bytes());
   const double halo_rows = 2.0 * filter.band_halo() + filter.band_alignment();
   // A file source keeps the rows consecutive bands share (io/band_reader.h).
   const double overlap = halo_rows * double(width) * 4.0 * input_channels;

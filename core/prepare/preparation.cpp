@@ -6,6 +6,7 @@
 #include "kernels/noise_scale.h"
 #include "prepare/albedo_prefilter.h"
 #include "prepare/demodulation.h"
+#include "prepare/exposure.h"
 #include "prepare/outliers.h"
 #include "prepare/pull_push.h"
 #include "util/error.h"
@@ -44,6 +45,7 @@ ParamTable with_preparation_params(ParamTable own, const PrepSteps& steps) {
                                    "clamp every colour channel to [-clamp, clamp] before filtering (after demodulation and "
                                    "firefly suppression); 0 = off"));
   }
+  if (steps.exposure) own.push_back(exposure_param());
   if (steps.step_back) {
     own.push_back(ParamSpec::Bool("step_back", true,
                                   "after filtering, blend the result toward the input wherever it is not estimated to beat "
@@ -191,7 +193,7 @@ Image rgb_copy(const Image& input, int nthreads) {
 }
 
 void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps, const Roi& work_in, int nthreads,
-             Prepared& out) {
+             Prepared& out, double exposure) {
   out.frame = &frame;
   out.notes.clear();
   out.divisor = Image();
@@ -201,6 +203,9 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   // Each step reads around the region of the next: fireflies read their window.
   const bool fireflies = steps.outliers && params.get_float("firefly_k") > 0;
   const Roi demod_region = fireflies ? work.grown(int(params.get_int("firefly_radius")), w, h) : work;
+
+  // Exposure first: every later step, and run(), sees the render at the scale its constants assume.
+  if (exposure != 1.0) scale_exposure(own_frame(frame, out), exposure, nthreads);
 
   // Sparse renders: fill every pass at the unsampled pixels first (thesis 5.1). The
   // pull-push pyramid spans the frame, so this step fills the whole frame.
@@ -263,7 +268,8 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
                                                 detail.empty() ? nullptr : &detail);
     if (clamped) out.notes.push_back("firefly suppression clamped " + std::to_string(clamped) + " pixels");
   }
-  if (steps.outliers) clamp_channels(out.colour, params.get_float("clamp"), work, nthreads);
+  // clamp is in the render's units.
+  if (steps.outliers) clamp_channels(out.colour, params.get_float("clamp") * exposure, work, nthreads);
 }
 
 std::size_t finish(const Prepared& prepared, const Image& input, const Roi& roi, int nthreads, Image& out) {

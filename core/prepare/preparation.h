@@ -1,5 +1,7 @@
 #pragma once
 // The preparation steps the base class runs before a filter's run(), in this order:
+//   exposure         a render far from display exposure filtered scaled into it, the result
+//                    scaled back after the step back (prepare/exposure.h): exposure
 //   holes            pull-push fill of the unsampled pixels, every pass (thesis 5.1):
 //                    holes = auto (sample_count == 0 where that pass exists) | none |
 //                    sample_count | alpha (alpha == 0)
@@ -27,8 +29,8 @@
 namespace mcr {
 
 struct PrepSteps {
-  bool holes = true, albedo_prefilter = true, demodulate = true, outliers = true, step_back = true;
-  static PrepSteps none() { return {false, false, false, false, false}; }
+  bool holes = true, albedo_prefilter = true, demodulate = true, outliers = true, step_back = true, exposure = true;
+  static PrepSteps none() { return {false, false, false, false, false, false}; }
 };
 
 // `own` followed by the parameters of the steps, then `components`.
@@ -81,9 +83,10 @@ struct Prepared {
 };
 
 // Runs the steps over `work` (clipped to the frame). Throws MissingPass naming the frame's
-// file for a pass a setting needs.
+// file for a pass a setting needs. exposure: the factor the exposure step chose (1: none);
+// the caller measures it over the whole frame (a band cannot) and scales the result back.
 void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps, const Roi& work, int nthreads,
-             Prepared& out);
+             Prepared& out, double exposure = 1.0);
 
 // After run() wrote `out` (RGB, the frame's size) inside roi: remodulated inside roi, the
 // input colour's RGB outside it, non-finite values replaced by 0 everywhere. Returns the

@@ -30,13 +30,13 @@ const FilterInfo& fake_info(bool temporal) {
 class FakeFilter : public Filter {
  public:
   explicit FakeFilter(bool temporal) : Filter(fake_info(temporal)) { commit(); }
-  void reset() override {
-    ++resets;
-    history = 0;
-  }
   int resets = 0, history = 0;
 
  protected:
+  void reset_history() override {
+    ++resets;
+    history = 0;
+  }
   void run(const Frame&, const Image&, const Roi&, Image&, int) override { ++history; }
 };
 

@@ -879,12 +879,15 @@ TEST(GuidedFilterTest, EpsilonFromTheNoiseIsTheDocumentedRule) {
   for (double sigma : {0.02, 0.2}) {
     SCOPED_TRACE(sigma);
     const Frame f = frame_of(noisy_plane(48, 32, sigma, 41));
-    const Result autoe = run_with_defaults(f, {});
+    // At the frame's own exposure (the rule is on the colour the filter gets; prepare/exposure.h
+    // would scale this plane, mean luminance above 1, by 1/2).
+    const Params off = {{"exposure", std::string("off")}};
+    const Result autoe = run_with_defaults(f, off);
     const double eps = guided::auto_epsilon(30.0, guided::frame_noise(f.image(Role::Colour), 1).relative);
     ASSERT_FALSE(autoe.stats.guide_scale.empty());
     EXPECT_NEAR(autoe.stats.guide_scale.back(), 1.0, 0.05);  // the colour guide: its level, not its std sigma
     // Without a colour channel in the guide the level plays no part: the rule is epsilon alone.
-    const Params nd = {{"guide", std::string("normal_depth")}};
+    const Params nd = testutil::with(off, {{"guide", std::string("normal_depth")}});
     expect_close(run_with_defaults(f, nd).out, run_with_defaults(f, testutil::with(nd, {{"epsilon", eps}})).out, 0.0,
                  "auto epsilon");
     bool noted = false;

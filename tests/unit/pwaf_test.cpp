@@ -195,8 +195,10 @@ TEST(PwafVarianceTest, VariancePassIsUsedWhenPresent) {
       for (int c = 0; c < 3; ++c) im.at(x, y, c) = 0.1f;
   Frame f = frame_of(im);
   f.passes.push_back(named_pass(Role::Variance, "variance", Image(32, 8, 1, 1e-8f)));
-  // firefly_k=0: no outlier step, whose count would be one more note.
-  const PwafRun tight = run_pwaf(f, {{"adaptive", false}, {"demodulate", false}, {"firefly_k", 0.0}});
+  // firefly_k=0: no outlier step, whose count would be one more note; exposure=off: this frame
+  // (mean luminance 0.05) would be filtered at 4x, one more note.
+  const PwafRun tight =
+      run_pwaf(f, {{"adaptive", false}, {"demodulate", false}, {"firefly_k", 0.0}, {"exposure", std::string("off")}});
   EXPECT_TRUE(tight.stats.variance_from_pass);
   EXPECT_TRUE(tight.notes.size() == 3u) << "only the dropped weights are noted";
   EXPECT_NEAR(tight.out.at(15, 4, 0), 0.0f, 1e-4);

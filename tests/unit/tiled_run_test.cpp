@@ -51,6 +51,28 @@ TEST_P(TiledRunTest, BandsGiveTheWholeFramesPixels) {
   }
 }
 
+// A render far below or above display exposure is scaled by the whole frame's level
+// (prepare/exposure.h), which no band sees alone: a first pass measures it.
+TEST_P(TiledRunTest, ADimOrBrightFrameIsScaledByTheWholeFramesLevel) {
+  for (float k : {1.0f / 64.0f, 48.0f}) {
+    Frame frame = read_frame(sample("room"));
+    for (Pass& p : frame.passes)
+      if (p.role == Role::Colour)
+        for (int y = 0; y < frame.height; ++y)  // the top band brighter: its own level would differ
+          for (int x = 0; x < frame.width; ++x)
+            for (int c = 0; c < 3; ++c) p.image.at(x, y, c) *= k * (y < 64 ? 3.0f : 1.0f);
+    auto filter = make_committed_filter(GetParam(), {});
+    const Image whole = filter->execute(frame);
+    bool scaled = false;
+    for (const std::string& n : filter->notes()) scaled = scaled || n.rfind("exposure:", 0) == 0;
+    EXPECT_TRUE(scaled) << k;
+    FrameRows rows(frame);
+    TiledOptions o;
+    o.band_rows = 64;
+    EXPECT_EQ(differing(whole, run_tiled(*filter, rows, o)), 0) << k;
+  }
+}
+
 // The normal pass constant over everything the first band reads (its rows and halo), varying
 // below: the band alone would drop its weight (kernels/feature_activity.h); the frame's
 // spread keeps it.

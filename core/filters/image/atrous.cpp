@@ -123,6 +123,7 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
   CrossPass pass;
   pass.pb = pb;
   set_colour_weight(pass, guides, params_, frame, colour, nthreads, noise_a_);
+  const double absolute_units = params_.get_enum("colour_weight") == "noise" ? 1.0 : exposure_scale();
   for (const Guides::Guide& g : guides.list) pass.guides.push_back(&g);
   // Neighbours must hold data (colour) and finite features: valid = ok * guides.ok,
   // here for the first pass, then written by each pass with its result.
@@ -144,8 +145,9 @@ void AtrousFilter::run(const Frame& frame, const Image& colour, const Roi& roi, 
     pass.out_ok = nxt_ok->data();
     pass.valid = valid->data();
     pass.out_valid = i < iterations ? nxt_valid->data() : nullptr;
-    // sigma_i = colour_sigma decay^(i-1): a_i = a / decay^(i-1), / scale for the scaled colour.
-    pass.colour_amul = float(std::min(1e30, std::pow(decay, -double(i - 1)) / double(cp.scale)));
+    // sigma_i = colour_sigma decay^(i-1): a_i = a / decay^(i-1), / scale for the scaled colour
+    // (and an absolute sigma, in the render's units, / the exposure step's factor).
+    pass.colour_amul = float(std::min(1e30, std::pow(decay, -double(i - 1)) / double(cp.scale) / absolute_units));
     pass.off.clear();
     pass.h.clear();
     for (int k = -half; k <= half; ++k) {

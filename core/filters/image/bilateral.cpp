@@ -62,7 +62,7 @@ std::vector<std::string> BilateralFilter::own_unused() const {
 
 void BilateralFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) {
   cross_bilateral_fit(frame, colour, params_, info().name, roi, out, nthreads, [this](std::string s) { note(std::move(s)); },
-                      scratch_);
+                      scratch_, exposure_scale());
 }
 
 }  // namespace mcr

@@ -166,7 +166,7 @@ void BmfrFilter::check_params() {
   phase1_.set_params(p);
 }
 
-void BmfrFilter::reset() {
+void BmfrFilter::reset_history() {
   phase1_.reset();
   phase3_.reset();
   taa_w_ = taa_h_ = 0;

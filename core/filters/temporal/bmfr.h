@@ -49,7 +49,7 @@ class BmfrFilter : public Filter {
  public:
   BmfrFilter() : Filter(static_info()) {}
   static const FilterInfo& static_info();
-  void reset() override;
+  void reset_history() override;
   // Its TAA runs after the remodulation: with light passes it must clip and blend the
   // component as shown (the colour pass's 1-spp edges included), as it does the beauty.
   bool demodulates_itself() const override { return params().get_bool("albedo_demodulation"); }
