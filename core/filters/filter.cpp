@@ -156,7 +156,7 @@ void Filter::begin_statistics() {
   drop_own_statistics();
   stats_state_ = StatsState::Measuring;
   // A band cannot see the frame's level: a first pass over every band measures it.
-  exposure_measuring_ = exposure_applies() && !exposure_pinned_;
+  exposure_measuring_ = exposure_applies() && exposure_pin_ == ExposurePin::None;
   exposure_level_ = ExposureLevel{};
 }
 
@@ -203,7 +203,8 @@ bool Filter::end_statistics_pass() {
   if (exposure_measuring_) {  // the exposure's pass: the statistics' own passes follow at its scale
     exposure_measuring_ = false;
     exposure_ = mcr::exposure_scale(exposure_level_);
-    exposure_pinned_ = exposure_from_stats_ = true;
+    exposure_level_seen_ = exposure_level_.level();
+    exposure_pin_ = ExposurePin::Statistics;
     return true;
   }
   if (stats_pass_ == 0) {
@@ -232,29 +233,29 @@ void Filter::drop_statistics() {
   stats_state_ = StatsState::None;
   stats_pass_ = 0;
   exposure_measuring_ = false;
-  if (exposure_from_stats_) exposure_pinned_ = exposure_from_stats_ = false;
+  if (exposure_pin_ == ExposurePin::Statistics) exposure_pin_ = ExposurePin::None;
 }
 
 void Filter::reset() {
-  if (!exposure_from_stats_) exposure_pinned_ = false;
+  if (exposure_pin_ == ExposurePin::History) exposure_pin_ = ExposurePin::None;
   reset_history();
 }
 
 void Filter::pin_exposure(double k) {
   exposure_ = k;
-  exposure_pinned_ = true;
-  exposure_from_stats_ = false;
+  exposure_pin_ = ExposurePin::Caller;
 }
 
 bool Filter::exposure_applies() const { return info_.steps.exposure && params_.get_enum("exposure") == "auto"; }
 
 double Filter::exposure_for(const Image& colour, int nthreads) {
   if (!exposure_applies()) return exposure_ = 1.0;
-  if (exposure_pinned_) return exposure_;
+  if (exposure_pin_ != ExposurePin::None) return exposure_;
   ExposureLevel level;
   level.add(colour, Roi::all(colour.width(), colour.height()), nthreads);
   exposure_ = mcr::exposure_scale(level);
-  if (info_.temporal) exposure_pinned_ = true;  // its history is at this scale
+  exposure_level_seen_ = level.level();
+  if (info_.temporal) exposure_pin_ = ExposurePin::History;  // its history is at this scale
   return exposure_;
 }
 
@@ -300,12 +301,18 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     return out;
   }
 
-  const double k = exposure_for(input, nthreads);
-  prepare(frame, params_, info_.steps, reads(roi, w, h), nthreads, prepared_, k);
-  if (k != 1.0)
-    note("exposure: filtered at " + rounded_text(k, 3) + "x the render's (its mean luminance " +
-         rounded_text(exposure_level_of(input, nthreads), 3) + " lies outside [" + rounded_text(kExposureLow, 2) + ", " +
-         rounded_text(kExposureHigh, 2) + "]), scaled back");
+  const double exposure = exposure_for(input, nthreads);
+  prepare(frame, params_, info_.steps, reads(roi, w, h), nthreads, prepared_, exposure);
+  if (exposure != 1.0) {
+    const char* whose = exposure_pin_ == ExposurePin::History ? ", the first frame's"
+                        : exposure_pin_ == ExposurePin::Statistics ? ", the whole frame's" : "";
+    note("exposure: filtered at " + rounded_text(exposure, 3) + "x the render's" +
+         (exposure_pin_ == ExposurePin::Caller ? std::string(" (as set)")
+                                               : " (mean luminance " + rounded_text(exposure_level_seen_, 3) + whose +
+                                                     ", outside [" + rounded_text(kExposureLow, 2) + ", " +
+                                                     rounded_text(kExposureHigh, 2) + "])") +
+         ", scaled back");
+  }
   for (std::string& n : prepared_.notes) notes_.push_back(std::move(n));
 
   Image out;
@@ -332,7 +339,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");
   }
   // Back to the render's exposure; outside the roi finish() kept the input bit for bit.
-  unscale_exposure(out, roi, k, nthreads);
+  unscale_exposure(out, roi, exposure, nthreads);
   prepared_.own = Frame{};  // the copied passes are not kept between frames
   prepared_.colour = Image{};
   return out;

@@ -73,10 +73,10 @@ class Filter {
   // Drops temporal history (new shot, frames out of order), and a temporal filter's exposure.
   void reset();
 
-  // The exposure step (prepare/exposure.h) at a fixed factor k instead of the frame's own:
-  // `auto` runs its candidates at 1 on the frame it scaled (a sample tile's level is not the
-  // frame's). A temporal filter pins the first frame's until reset(): its history is at that
-  // scale. Without the step (exposure=off, or a filter that does not take it) no effect.
+  // The exposure step (prepare/exposure.h) at a fixed factor k instead of the frame's own, for
+  // good: `auto` runs its candidates at 1 on the frame it scaled (a sample tile's level is not
+  // the frame's). (A temporal filter keeps its first frame's until reset(): its history is at
+  // that scale.) Without the step (exposure=off, or a filter that does not take it) no effect.
   void pin_exposure(double k);
   // Whether the exposure step may scale a frame (then it copies the passes it reads: the
   // memory a tiled run plans for).
@@ -208,8 +208,11 @@ class Filter {
   bool measuring_run_ = false;
   // The exposure step: the factor of the current run; pinned (by pin_exposure(), a temporal
   // filter's first frame, or a tiled run's first statistics pass, which measures it).
+  enum class ExposurePin { None, Caller, History, Statistics };
   double exposure_ = 1.0;
-  bool exposure_pinned_ = false, exposure_from_stats_ = false, exposure_measuring_ = false;
+  double exposure_level_seen_ = 0;  // the level exposure_ was chosen from (for the note)
+  ExposurePin exposure_pin_ = ExposurePin::None;
+  bool exposure_measuring_ = false;
   ExposureLevel exposure_level_;
   bool exposure_applies() const;
   double exposure_for(const Image& colour, int nthreads);

@@ -58,12 +58,6 @@ void ExposureLevel::add(const Image& colour, const Roi& rows_in, int nthreads) {
   }
 }
 
-double exposure_level_of(const Image& colour, int nthreads) {
-  ExposureLevel level;
-  level.add(colour, Roi::all(colour.width(), colour.height()), nthreads);
-  return level.level();
-}
-
 double exposure_scale(const ExposureLevel& e) {
   const double level = e.level();
   if (!(level > 0) || !std::isfinite(level)) return 1.0;

@@ -40,9 +40,6 @@ struct ExposureLevel {
   double level() const { return count > 0 ? sum / count : 0.0; }
 };
 
-// The level of a whole frame's colour.
-double exposure_level_of(const Image& colour, int nthreads);
-
 // The factor the render is filtered at: the least power of two that brings the level into the
 // band (below it: to [0.18, 0.36); above it: to (0.5, 1]), 1 inside it or for a level that is 0
 // or not finite; but no finite value is moved beyond [2^-120, 2^120] (a frame that spans the
