@@ -81,6 +81,8 @@ class Filter {
   // Whether the exposure step may scale a frame (then it copies the passes it reads: the
   // memory a tiled run plans for).
   bool exposure_may_scale() const { return exposure_applies(); }
+  // Whether begin_statistics() will first measure the frame's exposure (one more pass).
+  bool measures_exposure_first() const { return exposure_applies() && exposure_pin_ == ExposurePin::None; }
 
   // With light passes (pipeline/components.h): whether it divides each component by its
   // colour pass (the albedo it is given) itself and multiplies back before work that must

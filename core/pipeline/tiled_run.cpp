@@ -99,7 +99,9 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
     return band;
   };
 
-  int step = 0, passes = 1;
+  // The exposure's pass (Filter::measures_exposure_first) comes before the statistics' own.
+  bool exposure_pass = filter.measures_exposure_first();
+  int step = 0, passes = exposure_pass ? 2 : 1;
   auto stepped = [&] {
     ++step;
     if (options.progress) options.progress(step, (passes + 1) * plan.bands);
@@ -114,7 +116,10 @@ Image run_tiled(Filter& filter, BandSource& source, const TiledOptions& options,
         filter.measure(fetch(b, rows, r0), rows, options.nthreads);
         stepped();
       }
-      ++passes;
+      if (exposure_pass)
+        exposure_pass = false;  // counted from the start
+      else
+        ++passes;
     } while (filter.end_statistics_pass());
     --passes;
     if (filter.measured_holes())
