@@ -63,14 +63,20 @@ SCENES = {
                        "(Voronoi leaves over a Transparent BSDF) and a stucco wall, under a sun "
                        "and a sky: every feature pass is aliased at the wires and leaf edges; "
                        "held out: never used to choose settings."),
+    "night": ("still", "A street corner at night at its physical brightness (mean luminance about "
+                       "0.02, no film exposure): a sodium street lamp, a lit shop window, a wet "
+                       "puddle, a metal bin and a glossy box-car under a faint moonlit sky; held "
+                       "out: never used to choose settings."),
 }
-ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence"]
+ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence",
+         "night"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
-         "chrome": "report", "orbit": "report", "fog": "report", "fence": "report"}
+         "chrome": "report", "orbit": "report", "fog": "report", "fence": "report",
+         "night": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
-HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16]}
+HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16]}
 
 # Channel groups Blender writes (view layer "ViewLayer", compositing off).
 NOISY_PASSES = ["Combined", "Denoising Albedo", "Denoising Depth", "Denoising Normal", "Depth",

@@ -5,6 +5,7 @@
 #include "kernels/feature_activity.h"
 #include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
+#include "kernels/noise_scale.h"
 #include "prepare/step_back.h"
 #include "util/error.h"
 #include "util/isa.h"
@@ -241,8 +242,9 @@ void Filter::reset() {
   reset_history();
 }
 
-void Filter::pin_exposure(double k) {
+void Filter::pin_exposure(double k, double prior) {
   exposure_ = k;
+  exposure_prior_ = prior;
   exposure_pin_ = ExposurePin::Caller;
 }
 
@@ -333,7 +335,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
     const Image* modulation = step_back_modulation(params_, *prepared_.frame);
     const StepBackStats sb = step_back(prepared_.frame->image(Role::Colour), roi, int(params_.get_int("step_back_radius")),
                                        nthreads, out, variance ? &variance->image : nullptr, k,
-                                       modulation);
+                                       modulation, kRelMseEps * metric_scale() * metric_scale());
     note("step_back" + noise_source(variance != nullptr, modulation != nullptr, k) + ": mean weight of the filtered result " +
          rounded_text(sb.mean_weight, 2) + ", input kept (weight < 0.5) at " +
          rounded_text(100.0 * sb.input_share, 3) + "% of the pixels, " + std::to_string(sb.fireflies) + " fireflies removed");

@@ -77,7 +77,9 @@ class Filter {
   // good: `auto` runs its candidates at 1 on the frame it scaled (a sample tile's level is not
   // the frame's). (A temporal filter keeps its first frame's until reset(): its history is at
   // that scale.) Without the step (exposure=off, or a filter that does not take it) no effect.
-  void pin_exposure(double k);
+  // prior: the factor the frames it gets were already scaled by (auto's), so its step back
+  // still weighs errors as relMSE does on the render itself.
+  void pin_exposure(double k, double prior = 1.0);
   // Whether the exposure step may scale a frame (then it copies the passes it reads: the
   // memory a tiled run plans for).
   bool exposure_may_scale() const { return exposure_applies(); }
@@ -143,6 +145,9 @@ class Filter {
   // During run(): the factor the exposure step scaled the frame by (1: not scaled). A setting
   // in the render's colour units (an absolute colour sigma) is multiplied by it.
   double exposure_scale() const { return exposure_; }
+  // The factor between the colour run() sees and the render's own (this filter's exposure
+  // step times a caller's): relMSE's term 0.01 is 0.01 metric_scale()^2 in run()'s units.
+  double metric_scale() const { return exposure_ * exposure_prior_; }
   // The filter's own needs under params_ (default: info().required, plus the feature
   // block's use_<f>=on; info().optional less the use_<f>=off ones).
   virtual PassNeeds own_needs() const;
@@ -211,7 +216,7 @@ class Filter {
   // The exposure step: the factor of the current run; pinned (by pin_exposure(), a temporal
   // filter's first frame, or a tiled run's first statistics pass, which measures it).
   enum class ExposurePin { None, Caller, History, Statistics };
-  double exposure_ = 1.0;
+  double exposure_ = 1.0, exposure_prior_ = 1.0;
   double exposure_level_seen_ = 0;  // the level exposure_ was chosen from (for the note)
   ExposurePin exposure_pin_ = ExposurePin::None;
   bool exposure_measuring_ = false;

@@ -20,7 +20,7 @@ double clamp_float(double v) { return std::min(std::max(v, -double(kMax)), doubl
 }  // namespace
 
 StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int nthreads, Image& out,
-                        const Image* variance, double noise_scale, const Image* modulation) {
+                        const Image* variance, double noise_scale, const Image* modulation, double metric_eps) {
   // A variance pass is each pixel's own: exact in expectation, it is not scaled.
   const double scale = variance ? 1.0 : std::min(std::max(noise_scale, 0.0), 2.0);
   StepBackStats st;
@@ -48,7 +48,7 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
       const float* f = out.pixel(x, y);
       double nv = 0, dv = 0;
       for (int c = 0; c < 3; ++c) {
-        const double w = 1.0 / (double(m[c]) * m[c] + kRelMseEps);
+        const double w = 1.0 / (double(m[c]) * m[c] + metric_eps);
         const double d = double(f[c]) - double(p[c]);
         nv += w * scale * ns.variance_of(i, c);
         dv += w * d * d;

@@ -46,8 +46,11 @@ struct StepBackStats {
 // modulation: the albedo pass, or null: without a variance pass the noise is then estimated on
 // colour / albedo (the albedo clamped to [0.01, 1], non-finite read as 1) and scaled back by
 // albedo^2 per channel, so texture the albedo explains is not read as noise.
+// metric_eps: relMSE's term (x - r)^2 / (r^2 + 0.01) in the units of `input`: 0.01 where the
+// input is the render as it is, 0.01 k^2 where the exposure step (prepare/exposure.h) scaled it
+// by k, so the blend weighs errors as relMSE does on the render itself.
 StepBackStats step_back(const Image& input, const Roi& roi, int radius, int nthreads, Image& out,
                         const Image* variance = nullptr, double noise_scale = 1.0,
-                        const Image* modulation = nullptr);
+                        const Image* modulation = nullptr, double metric_eps = 0.01);
 
 }  // namespace mcr
