@@ -78,17 +78,6 @@ def bevel(obj, width, segments=5):
     return obj
 
 
-def point_light(name, location, radius, power, color=(1.0, 1.0, 1.0)):
-    data = bpy.data.lights.new(name, "POINT")
-    data.shadow_soft_size = radius
-    data.energy = power
-    data.color = color
-    obj = bpy.data.objects.new(name, data)
-    obj.location = location
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
-
-
 def build_room():
     C.plane("floor", (0.3, -0.5, 0.0), (3.0, 2.4),
             C.principled("floor_slate", (0.12, 0.12, 0.13), roughness=0.6))
@@ -160,7 +149,7 @@ def build():
     build_room()
     build_props()
     # The small strong lamp: up and to the right, in front of the counter, out of view.
-    point_light("lamp", (1.0, -0.45, 1.85), 0.025, 70.0, color=(1.0, 0.92, 0.8))
+    C.point_light("lamp", (1.0, -0.45, 1.85), 0.025, 70.0, color=(1.0, 0.92, 0.8))
 
     # Camera: two keys, a straight dolly left and in while panning the same way.
     cam = C.camera("camera", CAM_KEYS[0][0], CAM_KEYS[0][1], lens=26.0)

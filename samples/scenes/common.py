@@ -475,6 +475,18 @@ def area_light(name, location, size, power, color=(1.0, 1.0, 1.0), rotation=(0.0
     return obj
 
 
+def point_light(name, location, radius, power, color=(1.0, 1.0, 1.0)):
+    """Point lamp of `power` watts, a sphere of `radius` for soft shadows."""
+    data = bpy.data.lights.new(name, "POINT")
+    data.shadow_soft_size = radius
+    data.energy = power
+    data.color = color
+    obj = bpy.data.objects.new(name, data)
+    obj.location = location
+    bpy.context.scene.collection.objects.link(obj)
+    return obj
+
+
 def sun_light(name, rotation, strength, angle_deg=0.5, color=(1.0, 1.0, 1.0)):
     """Sun lamp; it shines along its local -Z, so `rotation` (Euler XYZ) aims it."""
     data = bpy.data.lights.new(name, "SUN")

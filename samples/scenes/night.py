@@ -14,21 +14,8 @@ import math
 import os
 import sys
 
-import bpy
-
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import common as C  # noqa: E402
-
-
-def point_light(name, location, power, radius, color):
-    data = bpy.data.lights.new(name, "POINT")
-    data.energy = power
-    data.shadow_soft_size = radius
-    data.color = color
-    obj = bpy.data.objects.new(name, data)
-    obj.location = location
-    bpy.context.scene.collection.objects.link(obj)
-    return obj
 
 
 def build():
@@ -62,7 +49,7 @@ def build():
     # The sodium lamp: a pole and a small warm bulb.
     C.cylinder("pole", (1.0, 6.3, 1.9), 0.05, 3.8, steel, vertices=16)
     C.sphere("bulb", (1.0, 6.0, 3.7), 0.07, C.emitter("sodium", (1.0, 0.62, 0.25), 10.0))
-    point_light("lamp", (1.0, 6.0, 3.62), 30.0, 0.05, (1.0, 0.62, 0.25))
+    C.point_light("lamp", (1.0, 6.0, 3.62), 0.05, 30.0, (1.0, 0.62, 0.25))
 
     C.camera("camera", (-0.2, -2.0, 1.5), (0.4, 5.0, 1.0), lens=30.0)
     return scene
