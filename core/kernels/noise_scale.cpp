@@ -116,10 +116,12 @@ double NoiseScales::variance_of(std::size_t i, int c) const {
   }
   // The illumination's variance shared among the channels as its median (the colour's over the
   // pixel's albedo) is, then scaled back by the albedo^2.
-  float flat[3];
-  for (int k = 0; k < 3; ++k) flat[k] = median[i * 3 + std::size_t(k)] / albedo[i * 3 + std::size_t(k)];
+  // In double: a median near FLT_MAX over an albedo of 0.01 overflows a float (inf / inf).
+  double flat[3];
+  for (int k = 0; k < 3; ++k) flat[k] = double(median[i * 3 + std::size_t(k)]) / albedo[i * 3 + std::size_t(k)];
   const double a = albedo[i * 3 + std::size_t(c)], m = flat[c];
-  return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(flat) + kRelativeEps) * a * a;
+  const double l2 = (flat[0] * flat[0] + flat[1] * flat[1] + flat[2] * flat[2]) / 3.0;
+  return double(variance[i]) * (m * m + kRelativeEps) / (l2 + kRelativeEps) * a * a;
 }
 
 NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads, const Image* vpass,

@@ -215,6 +215,23 @@ TEST(NoiseScale, NonFinitePixelsTakeNoPart) {
   EXPECT_EQ(s.variance[s.at(28, 28)], ref.variance[ref.at(28, 28)]);
 }
 
+// Values near the float range over a dark albedo (the illumination is then 100x the colour,
+// beyond a float): every channel's variance is finite and, where the colour is finite, >= 0.
+TEST(NoiseScale, TheIlluminationOfValuesNearTheFloatRangeStaysFinite) {
+  const int w = 24, h = 24;
+  Image im = blocks(w, h, 11, 0.05), albedo(w, h, 3, 0.005f);
+  for (int y = 0; y < h; ++y)
+    for (int x = 0; x < w; ++x)
+      for (int c = 0; c < 3; ++c) im.at(x, y, c) *= (x + y) % 3 == 0 ? 1e38f : 1e37f;
+  const NoiseScales s = estimate_noise_scales(im, Roi::all(w, h), 2, nullptr, &albedo);
+  ASSERT_FALSE(s.albedo.empty());
+  for (std::size_t i = 0; i < s.variance.size(); ++i)
+    for (int c = 0; c < 3; ++c) {
+      const double v = s.variance_of(i, c);
+      EXPECT_TRUE(std::isfinite(v) && v >= 0) << i << " " << c << ": " << v;
+    }
+}
+
 // The sample renders, against their references: the error of the noisy render is its
 // noise. Per 16x16 tile, the estimate within 2x of |noisy - reference|^2 at the median
 // tile, for 1, 4 and 16 spp, and it falls with the sample count as that error does.
