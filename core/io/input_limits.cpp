@@ -362,11 +362,19 @@ namespace {
 // size of its samples, which OpenEXR allocates before it reads them (a 1 KB file made it allocate
 // 973 MB). No chunk may claim more than its packed bytes can expand to, or lie past the file.
 void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
-  // Scanline files whose chunk count agrees with their window (1 line a chunk, 16 for zip);
-  // any other header is refused by the size checks that follow, with their own message.
-  if (part.tiled || !part.has_window || part.chunk_count < 0) return;
-  const std::int64_t lines = part.compression == 3 ? 16 : 1;
-  if (part.chunk_count != (part.height + lines - 1) / lines) return;
+  // Files whose chunk count agrees with their window: scanlines (1 line a chunk, 16 for zip),
+  // or one level of tiles (a mipmapped file's levels are left to OpenEXR); any other header is
+  // refused by the size checks that follow, with their own message.
+  if (!part.has_window || part.chunk_count < 0) return;
+  std::int64_t chunks = 0;
+  if (part.tiled) {
+    if (!part.has_tiles || part.tile_width <= 0 || part.tile_height <= 0) return;
+    chunks = ((part.width + part.tile_width - 1) / part.tile_width) * ((part.height + part.tile_height - 1) / part.tile_height);
+  } else {
+    const std::int64_t lines = part.compression == 3 ? 16 : 1;
+    chunks = (part.height + lines - 1) / lines;
+  }
+  if (part.chunk_count != chunks) return;
   if (std::uint64_t(part.chunk_count) > r.left() / 8)
     r.fail("its chunkCount " + std::to_string(part.chunk_count) + " needs a " +
            std::to_string(std::uint64_t(part.chunk_count) * 8) + "-byte offset table, more than the file holds");
@@ -374,9 +382,9 @@ void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
   for (auto& o : offsets) o = std::uint64_t(r.u32("the chunk offset table")) | std::uint64_t(r.u32("the chunk offset table")) << 32;
   const std::uint64_t size = r.pos() + r.left();
   const double expand = max_expansion("openexr", exr_compression_name(part.compression));
-  const std::uint64_t head = 4;  // the chunk's first scanline
+  const std::uint64_t head = part.tiled ? 16 : 4;  // the chunk's tile (x, y, level x, level y) or first scanline
   for (std::size_t k = 0; k < offsets.size(); ++k) {
-    const std::string chunk = "deep chunk " + std::to_string(k);
+    const std::string chunk = (part.tiled ? "deep tile chunk " : "deep chunk ") + std::to_string(k);
     if (offsets[k] > size || size - offsets[k] < head + 24) continue;  // OpenEXR reports a bad offset itself
     r.seek(offsets[k] + head);
     auto u64 = [&](const char* what) {

@@ -73,7 +73,7 @@ InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path);
 // channels as float against the budget, before anything reads them.
 void check_deep_samples(const std::string& path, int nchannels, const InputBudget& budget);
 
-// A single-part deep scanline EXR's chunk headers claim the sizes OpenEXR allocates before it
+// A single-part deep EXR's chunk headers (scanlines, or one level of tiles) claim the sizes OpenEXR allocates before it
 // reads them: refused (ReadFailed, naming the chunk) when a chunk's packed bytes lie past the
 // file or its unpacked bytes exceed what they can expand to. Call after the checks above.
 void check_deep_chunk_sizes(const std::string& path);

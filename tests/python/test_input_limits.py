@@ -212,6 +212,40 @@ class LimitsTest(unittest.TestCase):
         open(f, "wb").write(bytes(data))
         self.assert_refused_everywhere(f, "deep chunk 0 claims", "973078708")
 
+    def test_deep_tile_chunk_claiming_a_gigabyte(self):
+        # Found by fuzz_read_deep (a longer run than CI's): the same claim in a deep *tiled* file,
+        # whose chunks start with the tile's four coordinates instead of a scanline.
+        src = self.path("deep_tiled_ok.exr")
+        spec = oiio.ImageSpec(5, 4, 4, "float")
+        spec.channelnames = ("R", "G", "B", "Z")
+        spec.z_channel = 3
+        spec.deep = True
+        spec.tile_width = 2
+        spec.tile_height = 2
+        spec.attribute("compression", "zips")
+        dd = oiio.DeepData()
+        dd.init(spec)
+        for p in range(20):
+            dd.set_samples(p, 2)
+        out = oiio.ImageOutput.create(src)
+        self.assertTrue(out.open(src, spec) and out.write_deep_image(dd), out.geterror())
+        out.close()
+        rc, msg, _ = self.cli("info", src)
+        self.assertEqual(rc, 0, msg)  # the file as written reads
+        data = bytearray(open(src, "rb").read())
+        pos = 8
+        while data[pos] != 0:
+            name_end = data.index(0, pos)
+            type_end = data.index(0, name_end + 1)
+            size = int.from_bytes(data[type_end + 1:type_end + 5], "little")
+            pos = type_end + 5 + size
+        second = int.from_bytes(data[pos + 9:pos + 17], "little")  # 3x2 tiles: the second chunk
+        # Tile coordinates (16 bytes), the packed table size (8), then the packed data size.
+        data[second + 24:second + 32] = (1342177280).to_bytes(8, "little")
+        f = self.path("deep_tile_chunk_1gb.exr")
+        open(f, "wb").write(bytes(data))
+        self.assert_refused_everywhere(f, "deep tile chunk 1 claims", "1342177280")
+
     def test_max_memory_lowers_and_raises_the_limit(self):
         legit = self.path("legit.exr")
         small_exr(legit, 256, 256)  # 1.05 MB of float pixels
