@@ -362,19 +362,13 @@ namespace {
 // size of its samples, which OpenEXR allocates before it reads them (a 1 KB file made it allocate
 // 973 MB). No chunk may claim more than its packed bytes can expand to, or lie past the file.
 void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
-  // Files whose chunk count agrees with their window: scanlines (1 line a chunk, 16 for zip),
-  // or one level of tiles (a mipmapped file's levels are left to OpenEXR); any other header is
-  // refused by the size checks that follow, with their own message.
+  // Scanline files whose chunk count agrees with their window (1 line a chunk, 16 for zip), any
+  // other header being refused by the size checks that follow, with their own message; tiled
+  // files by their chunkCount as it stands (every level's tiles, as OpenEXR counts them).
   if (!part.has_window || part.chunk_count < 0) return;
-  std::int64_t chunks = 0;
-  if (part.tiled) {
-    if (!part.has_tiles || part.tile_width <= 0 || part.tile_height <= 0) return;
-    chunks = ((part.width + part.tile_width - 1) / part.tile_width) * ((part.height + part.tile_height - 1) / part.tile_height);
-  } else {
-    const std::int64_t lines = part.compression == 3 ? 16 : 1;
-    chunks = (part.height + lines - 1) / lines;
-  }
-  if (part.chunk_count != chunks) return;
+  if (part.tiled && !part.has_tiles) return;
+  const std::int64_t lines = part.compression == 3 ? 16 : 1;
+  if (!part.tiled && part.chunk_count != (part.height + lines - 1) / lines) return;
   if (std::uint64_t(part.chunk_count) > r.left() / 8)
     r.fail("its chunkCount " + std::to_string(part.chunk_count) + " needs a " +
            std::to_string(std::uint64_t(part.chunk_count) * 8) + "-byte offset table, more than the file holds");
