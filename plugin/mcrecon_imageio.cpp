@@ -282,8 +282,9 @@ class McreconInput final : public ImageInput {
   // must fit what the file can hold (input_limits.h): oiiotool allocates the spec
   // we return before it asks for a pixel.
   static ImageSpec source_header(const std::string& source) {
-    mcr::require_regular_file(source);  // before any open(): a FIFO would block it
-    mcr::check_exr_header_sizes(source);  // before OpenEXR allocates what the header claims
+    // Before any open(): a FIFO would block it, OpenEXR allocates what a header claims, the
+    // WebP reader decodes the whole image.
+    mcr::check_before_open(source);
     auto in = ImageInput::open(source);
     if (!in) {
       const std::string msg = OIIO::geterror();

@@ -441,6 +441,51 @@ void scan_exr(const std::string& path, bool deep_chunks) {
 
 void check_exr_header_sizes(const std::string& path) { scan_exr(path, false); }
 
+void check_before_open(const std::string& path) {
+  require_regular_file(path);
+  check_exr_header_sizes(path);
+  check_webp_header_size(path);
+}
+
+void check_webp_header_size(const std::string& path) {
+  std::ifstream file(path, std::ios::binary);
+  unsigned char b[30] = {};
+  file.read(reinterpret_cast<char*>(b), sizeof b);
+  const int got = int(file.gcount());
+  if (got >= 4 && std::memcmp(b, "\x76\x2f\x31\x01", 4) == 0) return;  // OpenEXR
+  auto le = [&](int at, int n) {
+    std::uint32_t v = 0;
+    for (int k = n - 1; k >= 0; --k) v = v << 8 | b[at + k];
+    return v;
+  };
+  // A lossless bitstream at `at` (signature 0x2f, then 14 bits each of width - 1 and height - 1)
+  // or a lossy one (a 3-byte frame tag, the start code 9d 01 2a, then 14 bits each).
+  std::int64_t w = 0, h = 0;
+  auto bitstream = [&](int at) {
+    if (got >= at + 5 && b[at] == 0x2f) {
+      const std::uint32_t v = le(at + 1, 4);
+      w = std::int64_t(v & 0x3fff) + 1;
+      h = std::int64_t((v >> 14) & 0x3fff) + 1;
+    } else if (got >= at + 10 && b[at + 3] == 0x9d && b[at + 4] == 0x01 && b[at + 5] == 0x2a) {
+      w = le(at + 6, 2) & 0x3fff;
+      h = le(at + 8, 2) & 0x3fff;
+    }
+  };
+  if (got >= 16 && std::memcmp(b, "RIFF", 4) == 0 && std::memcmp(b + 8, "WEBP", 4) == 0) {
+    if (std::memcmp(b + 12, "VP8X", 4) == 0 && got >= 30) {  // extended: the canvas, 24 bits each of size - 1
+      w = std::int64_t(le(24, 3)) + 1;
+      h = std::int64_t(le(27, 3)) + 1;
+    } else if (std::memcmp(b + 12, "VP8L", 4) == 0 || std::memcmp(b + 12, "VP8 ", 4) == 0) {
+      bitstream(20);
+    }
+  } else {
+    bitstream(0);  // libwebp also takes a bare bitstream, and OpenImageIO tries every reader on a file
+  }
+  if (w <= 0 || h <= 0) return;  // not a header this knows: OpenImageIO's readers say what it is
+  InputBudget::for_file(path, "webp", "").check(path, double(w) * double(h) * 4.0 * 4.0,
+                                               "its WebP header asks for " + dims(w, h, 4));
+}
+
 void check_deep_chunk_sizes(const std::string& path) { scan_exr(path, true); }
 
 InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path) {

@@ -73,6 +73,16 @@ InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path);
 // channels as float against the budget, before anything reads them.
 void check_deep_samples(const std::string& path, int nchannels, const InputBudget& budget);
 
+// For a WebP file (RIFF ... WEBP, whatever its name), before anything opens it: OpenImageIO's
+// reader decodes the whole image when it opens the file (a 1 KB file claiming 9574x15486 made it
+// allocate 593 MB), so the canvas size its first chunk declares is checked against the file's
+// budget first (ReadFailed, as InputBudget::check words it). Any other file passes untouched.
+void check_webp_header_size(const std::string& path);
+
+// Every check before a file is opened, in order: require_regular_file, check_exr_header_sizes,
+// check_webp_header_size (every front end's open goes through it).
+void check_before_open(const std::string& path);
+
 // A single-part deep EXR's chunk headers (scanlines, or one level of tiles) claim the sizes OpenEXR allocates before it
 // reads them: refused (ReadFailed, naming the chunk) when a chunk's packed bytes lie past the
 // file or its unpacked bytes exceed what they can expand to. Call after the checks above.

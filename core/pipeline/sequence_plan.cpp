@@ -7,6 +7,7 @@
 #include <limits>
 
 #include "io/exr_output.h"
+#include "io/input_limits.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -59,6 +60,11 @@ std::string stale_output_reason(const std::string& output, const std::string& fi
   // The header first: an output of another run is redone without decoding its pixels.
   std::string had_filter, had_params, had_input;
   {
+    try {
+      check_before_open(output);  // a header that asks for more than the file can hold is not read
+    } catch (const Error& e) {
+      return std::string("unreadable: ") + e.what();
+    }
     auto in = OIIO::ImageInput::open(output);
     if (!in) return "unreadable: " + OIIO::geterror();
     had_filter = in->spec().get_string_attribute("mcreconFilter");

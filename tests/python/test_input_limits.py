@@ -246,6 +246,29 @@ class LimitsTest(unittest.TestCase):
         open(f, "wb").write(bytes(data))
         self.assert_refused_everywhere(f, "deep tile chunk 1 claims", "1342177280")
 
+    def test_webp_header_claiming_gigabytes(self):
+        # Found by fuzz_read_deep: 85 bytes named .exr holding a bare lossless WebP bitstream header
+        # (0x2f, then 14 bits each of width - 1 and height - 1) that claims 9574x15486. OpenEXR
+        # refuses it, OpenImageIO then tries every reader, and its WebP reader allocates the decoded
+        # image (593 MB) inside open(), before any header check could run. The same claim in a
+        # RIFF container's extended header (24 bits each), named .webp.
+        v = (9574 - 1) | (15486 - 1) << 14
+        bare = self.path("bare_webp.exr")
+        open(bare, "wb").write(bytes([0x2F]) + v.to_bytes(4, "little") + bytes([0x1F]) * 80)
+        self.assert_refused_everywhere(bare, "its WebP header asks for 9574x15486x4 float", "file can hold at most")
+        vp8x = bytearray(b"RIFF") + (22).to_bytes(4, "little") + b"WEBPVP8X" + (10).to_bytes(4, "little")
+        vp8x += bytes(4) + (9574 - 1).to_bytes(3, "little") + (15486 - 1).to_bytes(3, "little")
+        riff = self.path("huge.webp")
+        open(riff, "wb").write(bytes(vp8x))
+        self.assert_refused_everywhere(riff, "its WebP header asks for 9574x15486x4 float", "file can hold at most")
+        # A real WebP still reads.
+        ok = self.path("small.webp")
+        r = subprocess.run([OIIOTOOL, "--pattern", "checker", "64x48", "4", "-d", "uint8", "-o", ok],
+                           capture_output=True, text=True)
+        self.assertEqual(r.returncode, 0, r.stderr)
+        rc, msg, _ = self.cli("info", ok)
+        self.assertEqual(rc, 0, msg)
+
     def test_max_memory_lowers_and_raises_the_limit(self):
         legit = self.path("legit.exr")
         small_exr(legit, 256, 256)  # 1.05 MB of float pixels
