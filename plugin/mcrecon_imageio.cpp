@@ -282,14 +282,7 @@ class McreconInput final : public ImageInput {
   // must fit what the file can hold (input_limits.h): oiiotool allocates the spec
   // we return before it asks for a pixel.
   static ImageSpec source_header(const std::string& source) {
-    // Before any open(): a FIFO would block it, OpenEXR allocates what a header claims, the
-    // WebP reader decodes the whole image.
-    mcr::check_before_open(source);
-    auto in = ImageInput::open(source);
-    if (!in) {
-      const std::string msg = OIIO::geterror();
-      throw mcr::Error(Errc::NotAnImage, "cannot read '" + source + "' as an image" + (msg.empty() ? "" : ": " + msg));
-    }
+    auto in = mcr::open_image(source);  // the checks before open(), then its extension's reader only
     mcr::check_header_fits(*in, source);
     return in->spec();
   }

@@ -24,8 +24,7 @@ constexpr int kMaxTileRows = 1024;  // a tiled file is decoded a row of tiles at
 
 std::unique_ptr<ImageInput> open_for_bands(const std::string& path, std::string& why) {
   check_image_file(path);  // FileNotFound, NotAnImage, a header its bytes cannot back
-  auto in = ImageInput::open(path);
-  if (!in) throw Error(Errc::ReadFailed, "cannot read '" + path + "': " + OIIO::geterror());
+  auto in = open_image(path);  // its extension's reader, as check_image_file opened it
   const ImageSpec& spec = in->spec();
   if (spec.deep) why = "it is a deep file";
   else if (in->seek_subimage(1, 0)) why = "it has several parts";

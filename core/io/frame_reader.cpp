@@ -191,12 +191,7 @@ void read_parts(ImageInput& in, RawImage& raw, const std::string& path) {
 // The file opened, after the checks every read needs: a regular file (a FIFO would block the
 // open), header sizes OpenEXR may allocate, then the header against what the file can hold.
 std::unique_ptr<ImageInput> open_checked(const std::string& path, InputBudget& budget) {
-  check_before_open(path);
-  auto in = ImageInput::open(path);
-  if (!in) {
-    std::string msg = OIIO::geterror();
-    throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
-  }
+  auto in = open_image(path);
   budget = check_header_fits(*in, path);
   return in;
 }

@@ -15,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <vector>
 
@@ -445,6 +446,29 @@ void check_before_open(const std::string& path) {
   require_regular_file(path);
   check_exr_header_sizes(path);
   check_webp_header_size(path);
+}
+
+std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
+  check_before_open(path);
+  std::string ext = std::filesystem::path(path).extension().string();
+  if (!ext.empty()) ext.erase(0, 1);
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+  std::unique_ptr<OIIO::ImageInput> in = ext.empty() ? nullptr : OIIO::ImageInput::create(ext, false);
+  if (!in) {
+    OIIO::geterror();  // no reader for that extension: nothing to report from the lookup
+    in = OIIO::ImageInput::open(path);
+    if (!in) {
+      const std::string msg = OIIO::geterror();
+      throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
+    }
+    return in;
+  }
+  OIIO::ImageSpec spec;
+  if (!in->open(path, spec)) {
+    const std::string msg = in->geterror();
+    throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
+  }
+  return in;
 }
 
 void check_webp_header_size(const std::string& path) {

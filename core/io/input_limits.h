@@ -5,6 +5,7 @@
 // MCRECON_MAX_MEMORY (bytes: "8G", "500M", "2GiB") replaces that bound in every
 // front end (CLI, OIIO plugin, Python module, Blender add-on).
 #include <cstdint>
+#include <memory>
 #include <string>
 
 #include <OpenImageIO/imageio.h>
@@ -82,6 +83,13 @@ void check_webp_header_size(const std::string& path);
 // Every check before a file is opened, in order: require_regular_file, check_exr_header_sizes,
 // check_webp_header_size (every front end's open goes through it).
 void check_before_open(const std::string& path);
+
+// check_before_open, then the file opened by the reader its extension names (x.exr by OpenEXR's),
+// never by another: OpenImageIO otherwise tries every reader on a file the named one refuses,
+// and some allocate what a header claims inside open() (a WebP bitstream in a file named .exr;
+// JPEG 2000 decodes whole images there too). A name without a known extension is opened as
+// OpenImageIO finds it. Throws NotAnImage naming the file and the reader's words.
+std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path);
 
 // A single-part deep EXR's chunk headers (scanlines, or one level of tiles) claim the sizes OpenEXR allocates before it
 // reads them: refused (ReadFailed, naming the chunk) when a chunk's packed bytes lie past the

@@ -60,13 +60,12 @@ std::string stale_output_reason(const std::string& output, const std::string& fi
   // The header first: an output of another run is redone without decoding its pixels.
   std::string had_filter, had_params, had_input;
   {
+    std::unique_ptr<OIIO::ImageInput> in;
     try {
-      check_before_open(output);  // a header that asks for more than the file can hold is not read
+      in = open_image(output);  // a header that asks for more than the file can hold is not read
     } catch (const Error& e) {
       return std::string("unreadable: ") + e.what();
     }
-    auto in = OIIO::ImageInput::open(output);
-    if (!in) return "unreadable: " + OIIO::geterror();
     had_filter = in->spec().get_string_attribute("mcreconFilter");
     had_params = in->spec().get_string_attribute("mcreconParameters");
     had_input = in->spec().get_string_attribute("mcreconInput");

@@ -261,13 +261,16 @@ class LimitsTest(unittest.TestCase):
         riff = self.path("huge.webp")
         open(riff, "wb").write(bytes(vp8x))
         self.assert_refused_everywhere(riff, "its WebP header asks for 9574x15486x4 float", "file can hold at most")
-        # A real WebP still reads.
+        # A real WebP still reads; named .exr it is refused by OpenEXR's reader, never handed to another.
         ok = self.path("small.webp")
         r = subprocess.run([OIIOTOOL, "--pattern", "checker", "64x48", "4", "-d", "uint8", "-o", ok],
                            capture_output=True, text=True)
         self.assertEqual(r.returncode, 0, r.stderr)
         rc, msg, _ = self.cli("info", ok)
         self.assertEqual(rc, 0, msg)
+        misnamed = self.path("webp_named.exr")
+        shutil.copy(ok, misnamed)
+        self.assert_refused_everywhere(misnamed, "is not an OpenEXR file")
 
     def test_max_memory_lowers_and_raises_the_limit(self):
         legit = self.path("legit.exr")
