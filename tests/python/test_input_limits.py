@@ -180,70 +180,61 @@ class LimitsTest(unittest.TestCase):
         f = self.hostile(100000, 100000)
         self.assert_refused_everywhere(f, "100000x100000x4 float (160 GB)", "file can hold at most")
 
-    def test_deep_chunk_claiming_a_gigabyte(self):
-        # Found by fuzz_read_deep: a 1 KB deep file whose chunk header claims 973 MB of packed
-        # samples made OpenEXR allocate them before it found the file's end.
-        src = self.path("deep_ok.exr")
-        spec = oiio.ImageSpec(4, 3, 4, "float")
+    def write_deep(self, name, w, h, tile=None):
+        """A deep RGBZ file of 2 samples a pixel (zips), tiled when `tile`; its bytes and chunk offsets."""
+        src = self.path(name)
+        spec = oiio.ImageSpec(w, h, 4, "float")
         spec.channelnames = ("R", "G", "B", "Z")
         spec.z_channel = 3
         spec.deep = True
+        if tile:
+            spec.tile_width = spec.tile_height = tile
         spec.attribute("compression", "zips")
         dd = oiio.DeepData()
         dd.init(spec)
-        for p in range(12):
-            dd.set_samples(p, 2)
-        out = oiio.ImageOutput.create(src)
-        self.assertTrue(out.open(src, spec) and out.write_deep_image(dd), out.geterror())
-        out.close()
-        data = bytearray(open(src, "rb").read())
-        # The first chunk: its offset is the first entry of the table after the header; its
-        # header is the scanline (4 bytes), then the packed table size and the packed data size.
-        # Walk the attributes to the header's end (an empty name); the offset table follows.
-        pos = 8
-        while data[pos] != 0:
-            name_end = data.index(0, pos)
-            type_end = data.index(0, name_end + 1)
-            size = int.from_bytes(data[type_end + 1:type_end + 5], "little")
-            pos = type_end + 5 + size
-        first = int.from_bytes(data[pos + 1:pos + 9], "little")
-        data[first + 12:first + 20] = (973078708).to_bytes(8, "little")
-        f = self.path("deep_chunk_1gb.exr")
-        open(f, "wb").write(bytes(data))
-        self.assert_refused_everywhere(f, "deep chunk 0 claims", "973078708")
-
-    def test_deep_tile_chunk_claiming_a_gigabyte(self):
-        # Found by fuzz_read_deep (a longer run than CI's): the same claim in a deep *tiled* file,
-        # whose chunks start with the tile's four coordinates instead of a scanline.
-        src = self.path("deep_tiled_ok.exr")
-        spec = oiio.ImageSpec(5, 4, 4, "float")
-        spec.channelnames = ("R", "G", "B", "Z")
-        spec.z_channel = 3
-        spec.deep = True
-        spec.tile_width = 2
-        spec.tile_height = 2
-        spec.attribute("compression", "zips")
-        dd = oiio.DeepData()
-        dd.init(spec)
-        for p in range(20):
+        for p in range(w * h):
             dd.set_samples(p, 2)
         out = oiio.ImageOutput.create(src)
         self.assertTrue(out.open(src, spec) and out.write_deep_image(dd), out.geterror())
         out.close()
         rc, msg, _ = self.cli("info", src)
         self.assertEqual(rc, 0, msg)  # the file as written reads
-        data = bytearray(open(src, "rb").read())
+        with open(src, "rb") as f:
+            data = bytearray(f.read())
+        # Walk the attributes to the header's end (an empty name); the chunk offset table follows.
         pos = 8
         while data[pos] != 0:
             name_end = data.index(0, pos)
             type_end = data.index(0, name_end + 1)
             size = int.from_bytes(data[type_end + 1:type_end + 5], "little")
             pos = type_end + 5 + size
-        second = int.from_bytes(data[pos + 9:pos + 17], "little")  # 3x2 tiles: the second chunk
+        table = pos + 1
+        return data, lambda k: int.from_bytes(data[table + 8 * k:table + 8 * k + 8], "little")
+
+    def write_bytes(self, name, data):
+        f = self.path(name)
+        with open(f, "wb") as out:
+            out.write(bytes(data))
+        return f
+
+    def test_deep_chunk_claiming_a_gigabyte(self):
+        # Found by fuzz_read_deep: a 1 KB deep file whose chunk header claims 973 MB of packed
+        # samples made OpenEXR allocate them before it found the file's end.
+        data, chunk = self.write_deep("deep_ok.exr", 4, 3)
+        # The first chunk's header: the scanline (4 bytes), the packed table size, the packed data size.
+        first = chunk(0)
+        data[first + 12:first + 20] = (973078708).to_bytes(8, "little")
+        f = self.write_bytes("deep_chunk_1gb.exr", data)
+        self.assert_refused_everywhere(f, "deep chunk 0 claims", "973078708")
+
+    def test_deep_tile_chunk_claiming_a_gigabyte(self):
+        # Found by fuzz_read_deep (a longer run than CI's): the same claim in a deep *tiled* file,
+        # whose chunks start with the tile's four coordinates instead of a scanline.
+        data, chunk = self.write_deep("deep_tiled_ok.exr", 5, 4, tile=2)
+        second = chunk(1)  # 3x2 tiles: the second chunk
         # Tile coordinates (16 bytes), the packed table size (8), then the packed data size.
         data[second + 24:second + 32] = (1342177280).to_bytes(8, "little")
-        f = self.path("deep_tile_chunk_1gb.exr")
-        open(f, "wb").write(bytes(data))
+        f = self.write_bytes("deep_tile_chunk_1gb.exr", data)
         self.assert_refused_everywhere(f, "deep tile chunk 1 claims", "1342177280")
 
     def test_webp_header_claiming_gigabytes(self):
@@ -253,13 +244,11 @@ class LimitsTest(unittest.TestCase):
         # image (593 MB) inside open(), before any header check could run. The same claim in a
         # RIFF container's extended header (24 bits each), named .webp.
         v = (9574 - 1) | (15486 - 1) << 14
-        bare = self.path("bare_webp.exr")
-        open(bare, "wb").write(bytes([0x2F]) + v.to_bytes(4, "little") + bytes([0x1F]) * 80)
+        bare = self.write_bytes("bare_webp.exr", bytes([0x2F]) + v.to_bytes(4, "little") + bytes([0x1F]) * 80)
         self.assert_refused_everywhere(bare, "its WebP header asks for 9574x15486x4 float", "file can hold at most")
         vp8x = bytearray(b"RIFF") + (22).to_bytes(4, "little") + b"WEBPVP8X" + (10).to_bytes(4, "little")
         vp8x += bytes(4) + (9574 - 1).to_bytes(3, "little") + (15486 - 1).to_bytes(3, "little")
-        riff = self.path("huge.webp")
-        open(riff, "wb").write(bytes(vp8x))
+        riff = self.write_bytes("huge.webp", vp8x)
         self.assert_refused_everywhere(riff, "its WebP header asks for 9574x15486x4 float", "file can hold at most")
         # A real WebP still reads; named .exr it is refused by OpenEXR's reader, never handed to another.
         ok = self.path("small.webp")
