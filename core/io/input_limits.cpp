@@ -366,14 +366,19 @@ void check_deep_chunks(ExrHeaderReader& r, const ExrPartHeader& part) {
   // Scanline files whose chunk count agrees with their window (1 line a chunk, 16 for zip), any
   // other header being refused by the size checks that follow, with their own message; tiled
   // files by their chunkCount as it stands (every level's tiles, as OpenEXR counts them).
-  if (!part.has_window || part.chunk_count < 0) return;
-  if (part.tiled && !part.has_tiles) return;
+  // Without a chunkCount OpenEXR counts the chunks from the window (one level of tiles at least).
+  if (!part.has_window) return;
+  if (part.tiled && (!part.has_tiles || part.tile_width <= 0 || part.tile_height <= 0)) return;
   const std::int64_t lines = part.compression == 3 ? 16 : 1;
-  if (!part.tiled && part.chunk_count != (part.height + lines - 1) / lines) return;
-  if (std::uint64_t(part.chunk_count) > r.left() / 8)
-    r.fail("its chunkCount " + std::to_string(part.chunk_count) + " needs a " +
-           std::to_string(std::uint64_t(part.chunk_count) * 8) + "-byte offset table, more than the file holds");
-  std::vector<std::uint64_t> offsets(std::size_t(part.chunk_count));
+  const std::int64_t from_window =
+      part.tiled ? ((part.width + part.tile_width - 1) / part.tile_width) * ((part.height + part.tile_height - 1) / part.tile_height)
+                 : (part.height + lines - 1) / lines;
+  if (!part.tiled && part.chunk_count >= 0 && part.chunk_count != from_window) return;
+  const std::int64_t count = part.chunk_count >= 0 ? part.chunk_count : from_window;
+  if (std::uint64_t(count) > r.left() / 8)
+    r.fail("its chunkCount " + std::to_string(count) + " needs a " + std::to_string(std::uint64_t(count) * 8) +
+           "-byte offset table, more than the file holds");
+  std::vector<std::uint64_t> offsets(static_cast<std::size_t>(count));
   for (auto& o : offsets) o = std::uint64_t(r.u32("the chunk offset table")) | std::uint64_t(r.u32("the chunk offset table")) << 32;
   const std::uint64_t size = r.pos() + r.left();
   const double expand = max_expansion("openexr", exr_compression_name(part.compression));
@@ -533,6 +538,12 @@ InputBudget check_header_fits(OIIO::ImageInput& in, const std::string& path) {
     channels += s.nchannels;
     same_size = same_size && s.width == first.width && s.height == first.height;
     ++parts;
+    if (s.tile_width <= 0 && !s.channelformats.empty()) {
+      // OpenImageIO reads scanlines of mixed channel types 256 rows at a time, however few the image has.
+      budget.check(path, 256.0 * w * double(s.pixel_bytes(true)),
+                   "its header asks for rows of " + std::to_string(s.width) +
+                       " pixels of mixed channel types, which OpenImageIO reads 256 rows at a time");
+    }
     if (s.tile_width > 0) {  // a tiled read buffers a whole row of tiles, and a tile may exceed the image
       const double tw = s.tile_width, th = s.tile_height, td = std::max(s.tile_depth, 1);
       const double row = std::ceil(w / tw) * tw * th * td * c * 4.0;

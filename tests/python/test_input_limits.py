@@ -237,6 +237,35 @@ class LimitsTest(unittest.TestCase):
         f = self.write_bytes("deep_tile_chunk_1gb.exr", data)
         self.assert_refused_everywhere(f, "deep tile chunk 1 claims", "1342177280")
 
+    def test_deep_chunk_claim_without_a_chunk_count(self):
+        # Found by fuzz_read_deep: the same claim in a file whose chunkCount attribute is misnamed;
+        # OpenEXR then counts the chunks from the window, and so does the check.
+        data, chunk = self.write_deep("deep_nocount.exr", 4, 3)
+        at = data.find(b"chunkCount\0")
+        self.assertGreater(at, 0)
+        data[at:at + 10] = b"chunkJount"
+        first = chunk(0)
+        data[first + 12:first + 20] = (1610612856).to_bytes(8, "little")
+        f = self.write_bytes("deep_nocount_1gb.exr", data)
+        self.assert_refused_everywhere(f, "deep chunk 0 claims", "1610612856")
+
+    def test_wide_rows_of_mixed_channel_types(self):
+        # Found by fuzz_read_frame: 379 bytes claiming one row of 1835009 pixels, R float, G uint,
+        # B float (22 MB, within the budget) made OpenImageIO allocate 5.6 GB: it reads scanlines of
+        # mixed channel types 256 rows at a time, however few the image has.
+        src = self.path("mixed.exr")
+        spec = oiio.ImageSpec(4, 1, 3, "float")
+        spec.channelformats = (oiio.FLOAT, oiio.UINT, oiio.FLOAT)
+        spec.attribute("compression", "none")
+        out = oiio.ImageOutput.create(src)
+        self.assertTrue(out.open(src, spec), out.geterror())
+        self.assertTrue(out.write_image(np.zeros((1, 4, 3), np.float32)), out.geterror())
+        out.close()
+        rc, msg, _ = self.cli("info", src)
+        self.assertEqual(rc, 0, msg)  # as written it reads
+        patch_window(src, 1835009, 1, lines=1)
+        self.assert_refused_everywhere(src, "rows of 1835009 pixels of mixed channel types", "256 rows at a time")
+
     def test_webp_header_claiming_gigabytes(self):
         # Found by fuzz_read_deep: 85 bytes named .exr holding a bare lossless WebP bitstream header
         # (0x2f, then 14 bits each of width - 1 and height - 1) that claims 9574x15486. OpenEXR
