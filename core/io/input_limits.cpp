@@ -459,20 +459,16 @@ std::unique_ptr<OIIO::ImageInput> open_image(const std::string& path) {
   if (!ext.empty()) ext.erase(0, 1);
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return char(std::tolower(c)); });
   std::unique_ptr<OIIO::ImageInput> in = ext.empty() ? nullptr : OIIO::ImageInput::create(ext, false);
+  std::string msg;
   if (!in) {
     OIIO::geterror();  // no reader for that extension: nothing to report from the lookup
     in = OIIO::ImageInput::open(path);
-    if (!in) {
-      const std::string msg = OIIO::geterror();
-      throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
-    }
-    return in;
+    if (!in) msg = OIIO::geterror();
+  } else if (OIIO::ImageSpec spec; !in->open(path, spec)) {
+    msg = in->geterror();
+    in.reset();
   }
-  OIIO::ImageSpec spec;
-  if (!in->open(path, spec)) {
-    const std::string msg = in->geterror();
-    throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
-  }
+  if (!in) throw Error(Errc::NotAnImage, "cannot read '" + path + "' as an image" + (msg.empty() ? "" : ": " + msg));
   return in;
 }
 

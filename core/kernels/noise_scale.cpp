@@ -49,6 +49,7 @@ float median_of(float* v, int n) {
 }
 
 double luminance2(const float* m) { return (double(m[0]) * m[0] + double(m[1]) * m[1] + double(m[2]) * m[2]) / 3.0; }
+double luminance2(const double* m) { return (m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) / 3.0; }
 
 // The per-channel range [lo, hi] of the 8 neighbours of (x, y) that ok() accepts; false
 // (lo = hi = the pixel) when there is none.
@@ -120,8 +121,7 @@ double NoiseScales::variance_of(std::size_t i, int c) const {
   double flat[3];
   for (int k = 0; k < 3; ++k) flat[k] = double(median[i * 3 + std::size_t(k)]) / albedo[i * 3 + std::size_t(k)];
   const double a = albedo[i * 3 + std::size_t(c)], m = flat[c];
-  const double l2 = (flat[0] * flat[0] + flat[1] * flat[1] + flat[2] * flat[2]) / 3.0;
-  return double(variance[i]) * (m * m + kRelativeEps) / (l2 + kRelativeEps) * a * a;
+  return double(variance[i]) * (m * m + kRelativeEps) / (luminance2(flat) + kRelativeEps) * a * a;
 }
 
 NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nthreads, const Image* vpass,

@@ -82,7 +82,7 @@ struct Sample {
   Roi inner;  // the tile, in the crop's coordinates
   NoiseScales noise;
   std::vector<float> sign_over_eps;  // SURE: b_c / eps_c per pixel of the tile and channel
-  std::vector<float> weight;         // relMSE weight 1 / (local mean_c^2 + metric_eps) per pixel and channel
+  std::vector<float> weight;         // relMSE weight 1 / (local mean_c^2 + 0.01) per pixel and channel
   std::vector<HeldPixel> held;       // held out: the pixels replaced in `masked`
   bool held_out() const { return !masked.passes.empty(); }
 };
@@ -90,7 +90,7 @@ struct Sample {
 // relMSE weighs by the reference; the 7x7 mean of the input (fireflies read as their
 // median) stands in for it, smooth enough that noise spread by the variance estimate
 // and the error a filter spreads are weighed alike.
-std::vector<float> local_weights(const Image& y, const NoiseScales& ns, const Roi& inner, double metric_eps) {
+std::vector<float> local_weights(const Image& y, const NoiseScales& ns, const Roi& inner) {
   std::vector<float> w(std::size_t(inner.width()) * inner.height() * 3, 0.0f);
   std::size_t k = 0;
   for (int yy = inner.y0; yy < inner.y1; ++yy)
@@ -107,7 +107,7 @@ std::vector<float> local_weights(const Image& y, const NoiseScales& ns, const Ro
         }
       for (int c = 0; c < 3; ++c, ++k) {
         const double m = n ? sum[c] / n : 0.0;
-        w[k] = float(1.0 / (m * m + metric_eps));
+        w[k] = float(1.0 / (m * m + kRelMseEps));
       }
     }
   return w;
@@ -194,8 +194,7 @@ void hold_out(Sample& s, int phase) {
     }
 }
 
-// metric_eps: relMSE's 0.01 in the frame's units (0.01 k^2 where the exposure step scaled it by k).
-Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthreads, double metric_eps) {
+Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthreads) {
   Sample s;
   const Roi outer = tile.grown(kMargin, frame.width, frame.height);
   s.frame = crop(frame, outer);
@@ -203,7 +202,7 @@ Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthre
   const Image& y = s.frame.image(Role::Colour);
   const Pass* variance = s.frame.find(Role::Variance);
   s.noise = estimate_noise_scales(y, s.inner, nthreads, variance ? &variance->image : nullptr);
-  s.weight = local_weights(y, s.noise, s.inner, metric_eps);
+  s.weight = local_weights(y, s.noise, s.inner);
   // Held out without a variance pass, unless the tile is too small to hold out a pixel with
   // its four neighbours inside (a region under 8x8: then SURE on the image's noise).
   if (!variance && s.inner.width() >= 8 && s.inner.height() >= 8) {
@@ -369,7 +368,6 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // relative noise (1%), which a dim render's own relMSE would meet at any noise (at 1/100 of the
   // stills' exposure auto kept every 4- and 16-spp input so: showroom 4 spp 0.113 against the
   // filtered 0.0104). The candidates' step backs still weigh as relMSE on the render itself.
-  const double metric_eps = kRelMseEps;
   // 1. Candidates: every image filter whose passes this frame has.
   std::vector<std::unique_ptr<Filter>> cands;
   std::string skipped;
@@ -396,7 +394,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   double in_sum = 0, in_ordinary = 0;
   std::size_t count = 0, ordinary_count = 0;
   for (std::size_t t = 0; t < tiles.size(); ++t) {
-    samples.push_back(make_sample(frame, tiles[t], unsigned(t + 1), nthreads, metric_eps));
+    samples.push_back(make_sample(frame, tiles[t], unsigned(t + 1), nthreads));
     const Sample& s = samples.back();
     in_sum += s.held_out() ? held_input(s, count, in_ordinary, ordinary_count) : input_risk(s, count);
   }
