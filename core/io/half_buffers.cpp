@@ -8,6 +8,18 @@
 
 namespace mcr {
 
+namespace {
+
+// Passes Blender writes from a pixel's first sample only (with sample_offset > 0 its Depth is
+// 1e10 and its Position 0): the first half's are the whole render's. Geometry at one hit is
+// not averaged across an edge either; the second-hit passes are single-hit too.
+bool written_on_first_sample(Role r) {
+  return r == Role::Depth || r == Role::Position || r == Role::Motion || r == Role::SecondPosition ||
+         r == Role::SecondNormal;
+}
+
+}  // namespace
+
 Frame combine_halves(Frame first, const Frame& second) {
   if (first.width != second.width || first.height != second.height)
     throw Error(Errc::SizeMismatch, "half buffers of different sizes: '" + first.path + "' is " + std::to_string(first.width) +
@@ -34,8 +46,32 @@ Frame combine_halves(Frame first, const Frame& second) {
         v[c] = float(std::min(d * d / 4.0, 3.0e38));  // beyond the float range: the largest float
         p[c] = float(0.5 * double(p[c]) + 0.5 * double(q[c]));
       }
+      for (int c = 3; c < std::min(a.channels(), b.channels()); ++c)  // alpha: accumulated like the colour
+        p[c] = float(0.5 * double(p[c]) + 0.5 * double(q[c]));
     }
   first.put(std::move(var));
+  // The feature passes: a renderer accumulates most over the samples, so each half holds half
+  // the samples' average and their mean is the whole render's (an 8-spp albedo, normal or light
+  // pass is noisier than the 16-spp one, and every feature filter weighed its neighbours by it).
+  for (Pass& p : first.passes) {
+    if (p.role == Role::Colour || p.role == Role::Variance) continue;
+    const Pass* q = nullptr;
+    for (const Pass& c : second.passes)
+      if (c.role == p.role && c.name == p.name && c.image.channels() == p.image.channels()) q = &c;
+    if (!q) continue;
+    if (written_on_first_sample(p.role)) continue;
+    const bool sum = p.role == Role::SampleCount;
+    float* d = p.image.data();
+    const float* o = q->image.data();
+    for (std::size_t i = 0, n = p.image.storage().size(); i < n; ++i) {
+      if (!std::isfinite(o[i])) continue;  // one half's value where the other has none
+      if (!std::isfinite(d[i])) {
+        d[i] = o[i];
+        continue;
+      }
+      d[i] = float(std::min(std::max(sum ? double(d[i]) + o[i] : 0.5 * d[i] + 0.5 * o[i], -3.0e38), 3.0e38));
+    }
+  }
   return first;
 }
 

@@ -61,6 +61,49 @@ TEST(HalfBuffers, MeanAndVarianceOfTheMeanOnKnownNoise) {
   }
 }
 
+// The feature passes a renderer accumulates over the samples are the halves' mean; the ones
+// Blender writes from the first sample only (depth, position, motion) stay the first's; a
+// value one half lacks is the other's.
+TEST(HalfBuffers, AccumulatedPassesAreAveragedFirstSamplePassesKept) {
+  const int w = 8, h = 6;
+  Frame fa = testutil::colour_frame(testutil::random_image(w, h, 3, 1));
+  Frame fb = testutil::colour_frame(testutil::random_image(w, h, 3, 2));
+  for (Role r : {Role::Albedo, Role::Normal, Role::Depth, Role::Position, Role::Motion, Role::DiffuseColour,
+                 Role::SampleCount}) {
+    const int ch = role_channels(r);
+    testutil::add_pass(fa, r, testutil::random_image(w, h, ch, 10 + unsigned(r)));
+    testutil::add_pass(fb, r, testutil::random_image(w, h, ch, 40 + unsigned(r)));
+  }
+  testutil::pass_image(fa, Role::Albedo).at(2, 3, 1) = testutil::kNaN;
+  testutil::pass_image(fb, Role::Albedo).at(4, 1, 0) = testutil::kInf;
+  // Blender's second half: depth 1e10, position 0.
+  testutil::pass_image(fb, Role::Depth) = Image(w, h, 1, 1e10f);
+  testutil::pass_image(fb, Role::Position) = Image(w, h, 3, 0.0f);
+  const Frame f = combine_halves(fa, fb);
+  for (Role r : {Role::Albedo, Role::Normal, Role::Depth, Role::Position, Role::Motion, Role::DiffuseColour,
+                 Role::SampleCount}) {
+    SCOPED_TRACE(role_name(r));
+    const Image& m = f.image(r);
+    const Image& a = fa.image(r);
+    const Image& b = fb.image(r);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x)
+        for (int c = 0; c < m.channels(); ++c) {
+          const float va = a.at(x, y, c), vb = b.at(x, y, c);
+          if (r == Role::Depth || r == Role::Position || r == Role::Motion)
+            EXPECT_EQ(m.at(x, y, c), va);
+          else if (!std::isfinite(va))
+            EXPECT_EQ(m.at(x, y, c), vb);
+          else if (!std::isfinite(vb))
+            EXPECT_EQ(m.at(x, y, c), va);
+          else if (r == Role::SampleCount)
+            EXPECT_FLOAT_EQ(m.at(x, y, c), va + vb);
+          else
+            EXPECT_FLOAT_EQ(m.at(x, y, c), 0.5f * va + 0.5f * vb);
+        }
+  }
+}
+
 // The sample scenes' halves: their mean is the 16-spp file, and the variance they give is
 // within 1.5x of |16 spp - reference|^2 at the median 16x16 tile.
 TEST(HalfBuffers, SampleHalvesGiveThe16SppRenderAndItsNoise) {
@@ -78,6 +121,26 @@ TEST(HalfBuffers, SampleHalvesGiveThe16SppRenderAndItsNoise) {
           for (int c = 0; c < 3; ++c)
             worst = std::max(worst, std::abs(double(y.at(x, yy, c)) - full.at(x, yy, c)) / (std::abs(full.at(x, yy, c)) + 1e-3));
       EXPECT_LT(worst, 2e-3);  // half-float rounding of three files
+      // Its feature passes are the 16-spp file's too (Blender accumulates them); depth,
+      // position and motion are the first half's.
+      const Frame whole = read_frame(sc.noisy.at(spp)), first = read_frame(pair.first);
+      int passes = 0;
+      for (const Pass& p : f.passes) {
+        if (p.role == Role::Colour || p.role == Role::Variance) continue;
+        const bool kept = p.role == Role::Depth || p.role == Role::Position || p.role == Role::Motion;
+        const Pass* q = nullptr;
+        for (const Pass& c : (kept ? first : whole).passes)
+          if (c.role == p.role && c.name == p.name) q = &c;
+        ASSERT_NE(q, nullptr) << p.name;
+        double d = 0, spread = 0;
+        for (std::size_t i = 0; i < p.image.storage().size(); ++i) {
+          d = std::max(d, std::abs(double(p.image.storage()[i]) - q->image.storage()[i]));
+          spread = std::max(spread, std::abs(double(q->image.storage()[i])));
+        }
+        EXPECT_LT(d, 4e-3 * std::max(spread, 1.0)) << p.name;  // half-float rounding, not 8 samples against 16
+        ++passes;
+      }
+      EXPECT_GE(passes, 4);
       const NoiseScales ns = estimate_noise_scales(y, Roi::all(y.width(), y.height()), 0, &f.image(Role::Variance));
       std::vector<double> ratio;
       for (int ty = 0; ty + 16 <= y.height(); ty += 16)
