@@ -88,12 +88,6 @@ void DenoiseSession::check_output(const std::string& input, const std::string& o
 Frame DenoiseSession::read_checked(const std::string& input, const std::string& output, const ReadOptions& read,
                                    const WriteOptions& write) const {
   if (write.keep_components) check_keep_components(reconstruction_.filter().params());
-  if (!read.second_half.empty() && reconstruction_.light_passes())
-    // Two half buffers are merged by their colour pass only (io/half_buffers.h): the light
-    // passes would come from the first half alone.
-    throw Error(Errc::InvalidArgument, "--half '" + read.second_half + "' with components=light_passes: the halves' "
-                                       "light passes are not merged; denoise one render with components=light_passes, "
-                                       "or the halves with components=beauty");
   check_output(input, output, read, write);
   return read_frame(input, read);
 }

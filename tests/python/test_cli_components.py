@@ -100,14 +100,28 @@ class ComponentsCliTest(unittest.TestCase):
         self.assertEqual(proc.returncode, 2, proc.stderr)
         for text in ("lights", "beauty", "light_passes"):
             self.assertIn(text, proc.stderr)
-        # Half buffers are merged by their colour only: refused rather than half the light passes.
+
+    def test_half_buffers_merge_every_light_pass(self):
+        # Two halves are their mean, light passes included (Blender accumulates them over the
+        # samples): the result is the light_passes run on one file of the averaged passes.
         other = self.path("other_half.exr")
-        lp.write_multilayer(other, lp.make_passes(seed=2))
-        proc = self.denoise("-f", "box", "--set", "components=light_passes", self.input, "--half", other,
-                            "-o", self.path("o.exr"), check=False)
-        self.assertEqual(proc.returncode, 2, proc.stderr)
-        self.assertIn("other_half.exr", proc.stderr)
-        self.assertFalse(os.path.exists(self.path("o.exr")))
+        second = lp.make_passes(seed=2)
+        lp.write_multilayer(other, second)
+        mean = {k: (0.5 * self.passes[k] + 0.5 * second[k]).astype(np.float32) for k in self.passes}
+        mean["Depth"] = self.passes["Depth"]  # written from the first sample: the first half's
+        merged = self.path("merged.exr")
+        lp.write_multilayer(merged, mean)
+        for filt in ("box", "bilateral"):
+            with self.subTest(filter=filt):
+                got, want = self.path("halves_%s.exr" % filt), self.path("merged_%s.exr" % filt)
+                self.denoise("-f", filt, "--set", "components=light_passes", self.input, "--half", other, "-o", got)
+                self.denoise("-f", filt, "--set", "components=light_passes", merged, "-o", want)
+                a, b = tu.read_channels(got, RGB), tu.read_channels(want, RGB)
+                np.testing.assert_allclose(a, b, rtol=1e-5, atol=1e-6)
+                # Not the first half's light alone.
+                first = self.path("first_%s.exr" % filt)
+                self.denoise("-f", filt, "--set", "components=light_passes", self.input, "-o", first)
+                self.assertGreater(np.abs(tu.read_channels(first, RGB) - a).max(), 1e-2)
 
     def test_every_filter_takes_components(self):
         listing = tu.run_cli_json("filters", "--json")
