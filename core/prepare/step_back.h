@@ -24,6 +24,9 @@
 // risk of the blend with the variance scaled by k is s^2 - (2k - k^2) gain: with k <= 2 still no
 // worse than the input where the estimate is right; a result that beats the input keeps a = 1
 // (clamped) down to an estimate 1/k of the truth.
+// With a variance pass (one draw of each pixel's variance, not a window mean) a is also taken
+// over a window twice as wide and the larger kept: the narrow ratio scatters enough to blend the
+// input's noise back where the result beats it everywhere (.cpp).
 // Non-finite input pixels keep the filter's value and take no part in any window.
 #include <cstddef>
 
