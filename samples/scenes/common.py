@@ -71,6 +71,11 @@ def parse_args(scene_name, default_size, sequence=False):
     if sequence:
         p.add_argument("--frames", type=_frame_range, default=(1, 16),
                        help="frame range, e.g. 1-16")
+    p.add_argument("--draw", type=int, default=0,
+                   help="stills: another draw of the noisy renders: 0 = the sample files' seeds; N > 0 seeds "
+                        "every noisy render (and its halves) differently, the reference unchanged "
+                        "(files named <scene>_<spp>spp_draw<N>.exr), to test a filter on renders "
+                        "it has never seen")
     p.add_argument("--save-blend", default="", help="also save the built scene to this .blend")
     args = p.parse_args(argv)
     args.sequence = sequence
@@ -637,14 +642,15 @@ def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT, light_passes=Fa
         info = {"scene": scene_name, "width": args.width, "height": args.height,
                 "camera": camera_info(scene)}
         for kind, spp, all_passes in jobs:
-            name = f"{scene_name}_{spp}spp.exr" if kind == "noisy" else f"{scene_name}_ref.exr"
-            seed = seed_for(scene_name, kind, spp)
+            draw = f"_draw{args.draw}" if args.draw and kind == "noisy" else ""
+            name = f"{scene_name}_{spp}spp{draw}.exr" if kind == "noisy" else f"{scene_name}_ref.exr"
+            seed = seed_for(scene_name + draw, kind, spp)
             dt = _render_one(scene, view_layer, os.path.join(out, name), spp, seed, all_passes,
                              light_passes=light_passes)
             _emit({"scene": scene_name, "file": name, "kind": kind, "spp": spp, "seed": seed,
                    "frame": None, "seconds": round(dt, 3), "all_passes": all_passes})
             if kind == "noisy" and spp in args.halves:
-                _render_halves(scene, view_layer, out, scene_name, spp, seed, light_passes)
+                _render_halves(scene, view_layer, out, scene_name, spp, seed, light_passes, draw)
         _emit_info(info, clamp_indirect, light_passes)
         return
 
@@ -668,12 +674,12 @@ def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT, light_passes=Fa
                 "camera": {str(k): v for k, v in cams.items()}}, clamp_indirect, light_passes)
 
 
-def _render_halves(scene, view_layer, out, scene_name, spp, seed, light_passes=False):
+def _render_halves(scene, view_layer, out, scene_name, spp, seed, light_passes=False, draw=""):
     if spp % 2:
         raise ValueError(f"--halves: {spp} spp cannot be split in two equal halves")
     half = spp // 2
     for i in (0, 1):
-        name = f"{scene_name}_{spp}spp_half{i}.exr"
+        name = f"{scene_name}_{spp}spp{draw}_half{i}.exr"
         dt = _render_one(scene, view_layer, os.path.join(out, name), half, seed, True,
                          sample_offset=i * half, light_passes=light_passes)
         _emit({"scene": scene_name, "file": name, "kind": "half", "spp": half, "of_spp": spp,
