@@ -54,12 +54,11 @@ Frame combine_halves(Frame first, const Frame& second) {
   // the samples' average and their mean is the whole render's (an 8-spp albedo, normal or light
   // pass is noisier than the 16-spp one, and every feature filter weighed its neighbours by it).
   for (Pass& p : first.passes) {
-    if (p.role == Role::Colour || p.role == Role::Variance) continue;
+    if (p.role == Role::Colour || p.role == Role::Variance || written_on_first_sample(p.role)) continue;
     const Pass* q = nullptr;
     for (const Pass& c : second.passes)
       if (c.role == p.role && c.name == p.name && c.image.channels() == p.image.channels()) q = &c;
     if (!q) continue;
-    if (written_on_first_sample(p.role)) continue;
     const bool sum = p.role == Role::SampleCount;
     float* d = p.image.data();
     const float* o = q->image.data();
