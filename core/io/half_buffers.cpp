@@ -36,18 +36,19 @@ Frame combine_halves(Frame first, const Frame& second) {
   var.source = first.path + " + " + second.path;
   var.channels = {"variance.R", "variance.G", "variance.B"};
   var.image = Image(first.width, first.height, 3);
+  const int shared = std::min(a.channels(), b.channels());
   for (int y = 0; y < first.height; ++y)
     for (int x = 0; x < first.width; ++x) {
       float* p = a.pixel(x, y);
       const float* q = b.pixel(x, y);
       float* v = var.image.pixel(x, y);
-      for (int c = 0; c < 3; ++c) {
-        const double d = double(p[c]) - double(q[c]);
-        v[c] = float(std::min(d * d / 4.0, 3.0e38));  // beyond the float range: the largest float
+      for (int c = 0; c < shared; ++c) {  // RGB and alpha, accumulated alike; the variance of RGB
+        if (c < 3) {
+          const double d = double(p[c]) - double(q[c]);
+          v[c] = float(std::min(d * d / 4.0, 3.0e38));  // beyond the float range: the largest float
+        }
         p[c] = float(0.5 * double(p[c]) + 0.5 * double(q[c]));
       }
-      for (int c = 3; c < std::min(a.channels(), b.channels()); ++c)  // alpha: accumulated like the colour
-        p[c] = float(0.5 * double(p[c]) + 0.5 * double(q[c]));
     }
   first.put(std::move(var));
   // The feature passes: a renderer accumulates most over the samples, so each half holds half

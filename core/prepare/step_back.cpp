@@ -20,6 +20,9 @@ constexpr float kMax = 3.402823466e38f;
 
 double clamp_float(double v) { return std::min(std::max(v, -double(kMax)), double(kMax)); }
 
+// The blend weight from a window's sums: Stein's s^2 / |f - y|^2, at most 1 (1 where f = y).
+double weight(double num, double den) { return den > 0 ? std::min(num / den, 1.0) : 1.0; }
+
 }  // namespace
 
 StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int nthreads, Image& out,
@@ -99,11 +102,8 @@ StepBackStats step_back(const Image& input, const Roi& roi_in, int radius, int n
       const float* p = input.pixel(x, y);
       const float* m = &ns.median[i * 3];
       const double n = num.value(x - roi.x0, y - roi.y0), d = den.value(x - roi.x0, y - roi.y0);
-      double a = d > 0 ? std::min(n / d, 1.0) : 1.0;
-      if (wide) {
-        const double nw = numw.value(x - roi.x0, y - roi.y0), dw = denw.value(x - roi.x0, y - roi.y0);
-        a = std::max(a, dw > 0 ? std::min(nw / dw, 1.0) : 1.0);
-      }
+      double a = weight(n, d);
+      if (wide) a = std::max(a, weight(numw.value(x - roi.x0, y - roi.y0), denw.value(x - roi.x0, y - roi.y0)));
       for (int c = 0; c < 3; ++c) {
         const double e = double(f[c]) - double(m[c]);
         const double limit = kOutlierSigmas * kOutlierSigmas * ns.robust(i, c);
