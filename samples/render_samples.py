@@ -67,16 +67,21 @@ SCENES = {
                        "0.02, no film exposure): a sodium street lamp, a lit shop window, a wet "
                        "puddle, a metal bin and a glossy box-car under a faint moonlit sky; held "
                        "out: never used to choose settings."),
+    "studio": ("still", "A photo table: a furry ball (particle hair far thinner than a pixel), a "
+                        "subsurface wax candle with a small bright flame, a screen showing an "
+                        "emissive wave pattern and two leaves lit from behind (translucent); a "
+                        "soft key light, a warm rim spot and a dim world; held out: never used "
+                        "to choose settings."),
 }
 ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence",
-         "night"]
+         "night", "studio"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
          "chrome": "report", "orbit": "report", "fog": "report", "fence": "report",
-         "night": "report"}
+         "night": "report", "studio": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
-HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16]}
+HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16], "studio": [16]}
 
 # Channel groups Blender writes (view layer "ViewLayer", compositing off).
 NOISY_PASSES = ["Combined", "Denoising Albedo", "Denoising Depth", "Denoising Normal", "Depth",
