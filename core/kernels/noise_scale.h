@@ -60,7 +60,7 @@ struct NoiseScales {
   double robust(std::size_t i, int c) const;
   double robust(std::size_t i) const { return (robust(i, 0) + robust(i, 1) + robust(i, 2)) / 3.0; }
   double variance_of(std::size_t i, int c) const;
-  // With a modulation (below): each pixel's albedo per channel, clamped; else empty.
+  // With a modulation (below): each pixel's albedo per channel, raised to the floor; else empty.
   std::vector<float> albedo;
 };
 
@@ -75,7 +75,8 @@ constexpr double kRelMseEps = 0.01;     // relMSE's denominator term, (x - r)^2 
 // the same window relative to each pixel's level and scaled back to the pixel's (.cpp).
 // modulation: an albedo pass, or null. Without a variance pass `variance` is then estimated on
 // the illumination, colour / albedo (the demodulation's albedo, kernels/albedo_divisor.h, at the
-// default floor: clamped to [0.01, 1], non-finite read as 1),
+// default floor but without its ceiling: raised to 0.01, non-finite read as 1; an emitter's
+// albedo is its emission, whose picture is no noise),
 // and variance_of scales it back by the pixel's albedo^2: texture the albedo explains (a thin
 // mortar line, an anti-aliased checker edge) is a peak the colour's products read as noise.
 // The medians, scales and outliers stay the colour's.
