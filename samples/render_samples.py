@@ -72,14 +72,20 @@ SCENES = {
                         "emissive wave pattern and two leaves lit from behind (translucent); a "
                         "soft key light, a warm rim spot and a dim world; held out: never used "
                         "to choose settings."),
+    "product": ("still", "A product shot on a transparent background (Film > Transparent) with a "
+                         "shadow-catcher floor: a glass perfume bottle with a gold cap, a glazed "
+                         "vase, a brushed-steel cube and a matte box under a soft key light, a rim "
+                         "light and a sky only the glass and metal show; the soft shadows live in "
+                         "the alpha; held out: never used to choose settings."),
 }
 ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence",
-         "night", "studio"]
+         "night", "studio",
+         "product"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
          "chrome": "report", "orbit": "report", "fog": "report", "fence": "report",
-         "night": "report", "studio": "report"}
+         "night": "report", "studio": "report", "product": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
 HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16], "studio": [16]}
 

@@ -105,9 +105,11 @@ def reset_scene():
     return bpy.context.scene
 
 
-def configure_render(scene, width, height, threads=0, clamp_indirect=CLAMP_INDIRECT, persistent=False):
+def configure_render(scene, width, height, threads=0, clamp_indirect=CLAMP_INDIRECT, persistent=False,
+                     transparent=False):
     """Everything that does not change between the renders of one scene. persistent: keep one
-    BVH for every render of the process (Blender's persistent data)."""
+    BVH for every render of the process (Blender's persistent data); transparent: Film >
+    Transparent (the world, and a shadow catcher's floor, alpha 0)."""
     r = scene.render
     r.engine = "CYCLES"
     r.resolution_x, r.resolution_y, r.resolution_percentage = width, height, 100
@@ -115,7 +117,7 @@ def configure_render(scene, width, height, threads=0, clamp_indirect=CLAMP_INDIR
     r.use_compositing = False
     r.use_sequencer = False
     r.use_motion_blur = False  # with motion blur the Vector pass is dropped
-    r.film_transparent = False
+    r.film_transparent = transparent
     r.use_persistent_data = persistent
     r.use_border = False
     if threads > 0:
@@ -619,17 +621,18 @@ def _render_one(scene, view_layer, path, spp, seed, all_passes, sample_offset=0,
     return dt
 
 
-def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT, light_passes=False, persistent=False):
+def render_jobs(args, scene_name, clamp_indirect=CLAMP_INDIRECT, light_passes=False, persistent=False,
+                transparent=False):
     """Render the noisy levels and the reference of a still, or of every frame of a sequence.
 
     `light_passes`: the noisy renders (and a reference with all passes) also carry Blender's
     light passes (LIGHT_PASSES); the other scenes leave it off, so their files do not change.
     A still's level listed in args.halves is also written as two half buffers: spp/2 samples
     each with the level's own seed and sample offsets 0 and spp/2, so that their mean is the
-    level's file (the same samples, split in two). `persistent`: one BVH for all of them
-    (configure_render)."""
+    level's file (the same samples, split in two). `persistent`, `transparent`: configure_render."""
     scene = bpy.context.scene
-    view_layer = configure_render(scene, args.width, args.height, args.threads, clamp_indirect, persistent)
+    view_layer = configure_render(scene, args.width, args.height, args.threads, clamp_indirect, persistent,
+                                  transparent)
     out = os.path.abspath(args.out)
     os.makedirs(out, exist_ok=True)
     if args.save_blend:
