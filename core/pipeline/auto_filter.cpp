@@ -157,17 +157,28 @@ double neighbourhood_range(const Image& y, const NoiseScales& ns, int x, int yy,
   return hi >= lo ? hi - lo : 0.0;
 }
 
-// Whether (x, y) and its four axis neighbours are fully covered (alpha >= 1, NaN as opaque). On
-// a transparent render (Film > Transparent, a shadow catcher) the world is 0 with alpha 0: exact,
-// not a sample of anything, and an object's edge against it is coverage. Held out there, the
-// neighbours' mean reads the whole step as the input's noise (the product still's 2048-spp
-// reference scored 0.0147 and was filtered: bilateral, 0.00078 from itself).
-bool opaque_cross(const Image& alpha, int x, int y) {
+// Whether (x, y) and its four axis neighbours may be held out on a render with an alpha pass
+// (NaN read as opaque). On a transparent render (Film > Transparent, a shadow catcher) the world
+// is an exact 0 with alpha 0, not a sample of anything, and an object's edge against it, or the
+// world seen through glass, is coverage: held out there, the neighbours' mean reads the step as
+// the input's noise (the product still's 2048-spp reference scored 0.0147 and was filtered:
+// bilateral, 0.00078 from itself). Opaque: all five at alpha 1. Where a tile has no such pixel
+// (a veil of smoke over the world, alpha below 1 everywhere) it holds out the pixels covered
+// alike instead: alpha above 0, all five within kCoverageStep.
+constexpr float kCoverageStep = 1.0f / 64.0f;
+
+enum class Coverage { Opaque, Even };
+
+bool covered(const Image& alpha, int x, int y, Coverage rule) {
+  float lo = HUGE_VALF, hi = -HUGE_VALF;
   for (const auto& [dx, dy] : {std::pair{0, 0}, std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-    const float a = alpha.at(x + dx, y + dy, 0);
-    if (a < 1.0f) return false;
+    float a = alpha.at(x + dx, y + dy, 0);
+    if (a != a) a = 1.0f;
+    if (rule == Coverage::Opaque ? !(a >= 1.0f) : !(a > 0.0f)) return false;
+    lo = std::min(lo, a);
+    hi = std::max(hi, a);
   }
-  return true;
+  return hi - lo <= kCoverageStep;
 }
 
 // s.masked: s.frame with the pixels of the blind-spot pattern inside the tile (its outer ring
@@ -188,12 +199,23 @@ void hold_out(Sample& s, int phase) {
   Pass& colour = const_cast<Pass&>(s.masked.get(Role::Colour));  // the pass the filters read as colour
   const Image& y = s.frame.image(Role::Colour);
   const Pass* alpha = s.frame.find(Role::Alpha);
+  auto pattern = [&](int x, int yy) {
+    return (x + 2 * yy + phase) % kMaskPeriod == 0 && s.noise.finite[s.noise.at(x, yy)];
+  };
+  Coverage rule = Coverage::Opaque;
+  if (alpha) {
+    bool any = false;
+    for (int yy = s.inner.y0 + 1; yy + 1 < s.inner.y1 && !any; ++yy)
+      for (int x = s.inner.x0 + 1; x + 1 < s.inner.x1 && !any; ++x)
+        any = pattern(x, yy) && covered(alpha->image, x, yy, Coverage::Opaque);
+    if (!any) rule = Coverage::Even;
+  }
   float mean[3];
   for (int yy = s.inner.y0 + 1; yy + 1 < s.inner.y1; ++yy)
     for (int x = s.inner.x0 + 1; x + 1 < s.inner.x1; ++x) {
       const std::size_t i = s.noise.at(x, yy);
-      if ((x + 2 * yy + phase) % kMaskPeriod != 0 || !s.noise.finite[i] || !neighbour_mean(y, s.noise, x, yy, mean)) continue;
-      if (alpha && !opaque_cross(alpha->image, x, yy)) continue;
+      if (!pattern(x, yy) || !neighbour_mean(y, s.noise, x, yy, mean)) continue;
+      if (alpha && !covered(alpha->image, x, yy, rule)) continue;
       std::copy(mean, mean + 3, colour.image.pixel(x, yy));
       const std::size_t k = std::size_t(yy - s.inner.y0) * std::size_t(s.inner.width()) + std::size_t(x - s.inner.x0);
       HeldPixel h{x, yy, {}, {}, far_out(s, i)};

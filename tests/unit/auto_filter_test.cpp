@@ -207,6 +207,26 @@ TEST(AutoFilter, TheReferencesAreKeptAsTheyAre) {
   }
 }
 
+// Held-out pixels need full coverage (alpha 1 around them) where a tile has any: above, the
+// product still's reference. A render whose alpha is below 1 everywhere alike (a veil of smoke
+// over a transparent world) is scored on the pixels covered alike instead, as if opaque: the
+// glossy still at 16 spp with alpha 0.5 everywhere gives auto's choice and output with alpha 1
+// (with full coverage required everywhere no pixel is held out, every score is 0, and the input
+// was kept as converged). The alpha 1 -> 0.5 -> 0 and back at a coverage edge is left out.
+TEST(AutoFilter, AVeilOfAlphaIsScoredLikeAnOpaqueRender) {
+  const Frame opaque = read_frame(std::string(MCRECON_SOURCE_DIR) + "/samples/data/glossy/glossy_16spp.exr");
+  ASSERT_NE(opaque.find(Role::Alpha), nullptr);
+  Frame veiled = opaque;
+  for (Pass& p : veiled.passes)
+    if (p.role == Role::Alpha)
+      for (std::size_t i = 0; i < p.image.pixel_count(); ++i) p.image.data()[i * std::size_t(p.image.channels())] = 0.5f;
+  AutoFilter a, b;
+  const Image want = run_auto(opaque, a), got = run_auto(veiled, b);
+  EXPECT_NE(a.chosen(), "input");
+  EXPECT_EQ(b.chosen(), a.chosen());
+  EXPECT_EQ(got.storage(), want.storage());
+}
+
 // The same render drawn twice (the dof still at 64 spp, rendered again: other noise, relMSE
 // 0.0198 against the first's 0.0200) is filtered both times. Oracle: the 2048-spp reference; on
 // both, pwaf cuts the error about 4x. The held-out scores of pwaf and the input tie on the second
