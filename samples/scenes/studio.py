@@ -37,18 +37,24 @@ def wax_material():
     return mat
 
 
+def ramp_texture(nt, node_type, inputs, c0, c1):
+    """A texture node (object coordinates) through a two-colour ramp: the ramp node."""
+    tc = nt.nodes.new("ShaderNodeTexCoord")
+    tex = nt.nodes.new(node_type)
+    for socket, value in inputs.items():
+        tex.inputs[socket].default_value = value
+    nt.links.new(tc.outputs["Object"], tex.inputs["Vector"])
+    ramp = nt.nodes.new("ShaderNodeValToRGB")
+    ramp.color_ramp.elements[0].color = (*c0, 1.0)
+    ramp.color_ramp.elements[1].color = (*c1, 1.0)
+    nt.links.new(tex.outputs["Fac"], ramp.inputs["Fac"])
+    return ramp
+
+
 def screen_material():
     """An emissive wave pattern (the picture on a small screen)."""
     mat, nt, out = C.bare_material("screen")
-    tc = nt.nodes.new("ShaderNodeTexCoord")
-    wave = nt.nodes.new("ShaderNodeTexWave")
-    wave.inputs["Scale"].default_value = 6.0
-    wave.inputs["Distortion"].default_value = 4.0
-    nt.links.new(tc.outputs["Object"], wave.inputs["Vector"])
-    ramp = nt.nodes.new("ShaderNodeValToRGB")
-    ramp.color_ramp.elements[0].color = (0.05, 0.15, 0.6, 1.0)
-    ramp.color_ramp.elements[1].color = (1.0, 0.55, 0.15, 1.0)
-    nt.links.new(wave.outputs["Fac"], ramp.inputs["Fac"])
+    ramp = ramp_texture(nt, "ShaderNodeTexWave", {"Scale": 6.0, "Distortion": 4.0}, (0.05, 0.15, 0.6), (1.0, 0.55, 0.15))
     em = nt.nodes.new("ShaderNodeEmission")
     em.inputs["Strength"].default_value = 3.0
     nt.links.new(ramp.outputs["Color"], em.inputs["Color"])
@@ -59,15 +65,7 @@ def screen_material():
 def leaf_material():
     """Thin leaf: translucent and diffuse mixed, veins from a noise texture."""
     mat, nt, out = C.bare_material("leaf")
-    tc = nt.nodes.new("ShaderNodeTexCoord")
-    noise = nt.nodes.new("ShaderNodeTexNoise")
-    noise.inputs["Scale"].default_value = 14.0
-    noise.inputs["Detail"].default_value = 8.0
-    nt.links.new(tc.outputs["Object"], noise.inputs["Vector"])
-    ramp = nt.nodes.new("ShaderNodeValToRGB")
-    ramp.color_ramp.elements[0].color = (0.1, 0.3, 0.04, 1.0)
-    ramp.color_ramp.elements[1].color = (0.45, 0.7, 0.15, 1.0)
-    nt.links.new(noise.outputs["Fac"], ramp.inputs["Fac"])
+    ramp = ramp_texture(nt, "ShaderNodeTexNoise", {"Scale": 14.0, "Detail": 8.0}, (0.1, 0.3, 0.04), (0.45, 0.7, 0.15))
     diffuse = nt.nodes.new("ShaderNodeBsdfDiffuse")
     trans = nt.nodes.new("ShaderNodeBsdfTranslucent")
     nt.links.new(ramp.outputs["Color"], diffuse.inputs["Color"])
