@@ -6,6 +6,7 @@
 #include "kernels/feature_guides.h"
 #include "kernels/foveation.h"
 #include "kernels/noise_scale.h"
+#include "prepare/empty_pixels.h"
 #include "prepare/step_back.h"
 #include "util/error.h"
 #include "util/isa.h"
@@ -342,6 +343,9 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   }
   // Back to the render's exposure; outside the roi finish() kept the input bit for bit.
   unscale_exposure(out, roi, exposure, nthreads);
+  if (const Pass* alpha = frame.find(Role::Alpha))
+    if (const std::size_t kept = keep_empty_pixels(alpha->image, input, roi, out))
+      note(std::to_string(kept) + " pixels with nothing rendered (alpha 0, colour 0) kept at 0");
   prepared_.own = Frame{};  // the copied passes are not kept between frames
   prepared_.colour = Image{};
   return out;
