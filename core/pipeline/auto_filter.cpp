@@ -173,7 +173,7 @@ bool covered(const Image& alpha, int x, int y, Coverage rule) {
   float lo = HUGE_VALF, hi = -HUGE_VALF;
   for (const auto& [dx, dy] : {std::pair{0, 0}, std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
     float a = alpha.at(x + dx, y + dy, 0);
-    if (a != a) a = 1.0f;
+    if (std::isnan(a)) a = 1.0f;
     if (rule == Coverage::Opaque ? !(a >= 1.0f) : !(a > 0.0f)) return false;
     lo = std::min(lo, a);
     hi = std::max(hi, a);
@@ -199,36 +199,29 @@ void hold_out(Sample& s, int phase) {
   Pass& colour = const_cast<Pass&>(s.masked.get(Role::Colour));  // the pass the filters read as colour
   const Image& y = s.frame.image(Role::Colour);
   const Pass* alpha = s.frame.find(Role::Alpha);
-  auto pattern = [&](int x, int yy) {
-    return (x + 2 * yy + phase) % kMaskPeriod == 0 && s.noise.finite[s.noise.at(x, yy)];
-  };
-  Coverage rule = Coverage::Opaque;
-  if (alpha) {
-    bool any = false;
-    for (int yy = s.inner.y0 + 1; yy + 1 < s.inner.y1 && !any; ++yy)
-      for (int x = s.inner.x0 + 1; x + 1 < s.inner.x1 && !any; ++x)
-        any = pattern(x, yy) && covered(alpha->image, x, yy, Coverage::Opaque);
-    if (!any) rule = Coverage::Even;
-  }
   float mean[3];
-  for (int yy = s.inner.y0 + 1; yy + 1 < s.inner.y1; ++yy)
-    for (int x = s.inner.x0 + 1; x + 1 < s.inner.x1; ++x) {
-      const std::size_t i = s.noise.at(x, yy);
-      if (!pattern(x, yy) || !neighbour_mean(y, s.noise, x, yy, mean)) continue;
-      if (alpha && !covered(alpha->image, x, yy, rule)) continue;
-      std::copy(mean, mean + 3, colour.image.pixel(x, yy));
-      const std::size_t k = std::size_t(yy - s.inner.y0) * std::size_t(s.inner.width()) + std::size_t(x - s.inner.x0);
-      HeldPixel h{x, yy, {}, {}, far_out(s, i)};
-      for (int c = 0; c < 3; ++c) {
-        h.w[c] = s.weight[k * 3 + std::size_t(c)];
-        h.e[c] = input_error(s, i, c, y.pixel(x, yy));
-        if (!h.far) {
-          const double r = neighbourhood_range(y, s.noise, x, yy, c);
-          h.e[c] = std::min(h.e[c], kRangeCap * r * r);
+  auto hold = [&](Coverage rule) {
+    for (int yy = s.inner.y0 + 1; yy + 1 < s.inner.y1; ++yy)
+      for (int x = s.inner.x0 + 1; x + 1 < s.inner.x1; ++x) {
+        const std::size_t i = s.noise.at(x, yy);
+        if ((x + 2 * yy + phase) % kMaskPeriod != 0 || !s.noise.finite[i] || !neighbour_mean(y, s.noise, x, yy, mean)) continue;
+        if (alpha && !covered(alpha->image, x, yy, rule)) continue;
+        std::copy(mean, mean + 3, colour.image.pixel(x, yy));
+        const std::size_t k = std::size_t(yy - s.inner.y0) * std::size_t(s.inner.width()) + std::size_t(x - s.inner.x0);
+        HeldPixel h{x, yy, {}, {}, far_out(s, i)};
+        for (int c = 0; c < 3; ++c) {
+          h.w[c] = s.weight[k * 3 + std::size_t(c)];
+          h.e[c] = input_error(s, i, c, y.pixel(x, yy));
+          if (!h.far) {
+            const double r = neighbourhood_range(y, s.noise, x, yy, c);
+            h.e[c] = std::min(h.e[c], kRangeCap * r * r);
+          }
         }
+        s.held.push_back(h);
       }
-      s.held.push_back(h);
-    }
+  };
+  hold(Coverage::Opaque);
+  if (alpha && s.held.empty()) hold(Coverage::Even);  // nothing held out, nothing replaced yet
 }
 
 Sample make_sample(const Frame& frame, const Roi& tile, unsigned seed, int nthreads) {

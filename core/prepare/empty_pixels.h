@@ -8,7 +8,6 @@
 #include <cstddef>
 
 #include "image/image.h"
-#include "image/pass.h"
 
 namespace mcr {
 
