@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cstdio>
 #include <iostream>
 
@@ -20,11 +21,13 @@ struct CompareArgs {
   int threads = 0;
 };
 
-Image colour_of(const std::string& path, const std::string& layer) {
+Frame frame_of(const std::string& path, const std::string& layer) {
   ReadOptions ro;
   ro.layer = layer;
-  return read_frame(path, ro).image(Role::Colour);
+  return read_frame(path, ro);
 }
+
+Image colour_of(const std::string& path, const std::string& layer) { return frame_of(path, layer).image(Role::Colour); }
 
 nlohmann::json metrics_json(const ImageMetrics& m) {
   return {{"rmse", number(m.rmse)}, {"relmse", number(m.relmse)}, {"psnr", number(m.psnr)}, {"ssim", number(m.ssim)}};
@@ -38,11 +41,24 @@ int run_compare(const CompareArgs& a) {
   const bool seq = is_sequence_pattern(a.image) || is_sequence_pattern(a.reference);
   if (!seq) {
     if (!a.frames.empty()) throw Error(Errc::InvalidArgument, "--frames needs sequence patterns (#### or %04d)");
-    const Image ref = colour_of(a.reference, a.ref_layer);
-    const Image img = colour_of(a.image, a.layer);
-    const ImageMetrics m = compare_images(ref, img, a.threads);
-    if (a.json) std::cout << metrics_json(m).dump(2) << "\n";
-    else print_metrics(m);
+    const Frame ref = frame_of(a.reference, a.ref_layer);
+    const Frame img = frame_of(a.image, a.layer);
+    const ImageMetrics m = compare_images(ref.image(Role::Colour), img.image(Role::Colour), a.threads);
+    // The alpha's error where both have one and either is transparent somewhere (alpha=filter
+    // filters it too); an opaque pair says nothing new.
+    const Pass *ra = ref.find(Role::Alpha), *ia = img.find(Role::Alpha);
+    auto opaque = [](const Pass* p) {
+      return std::all_of(p->image.storage().begin(), p->image.storage().end(), [](float v) { return v == 1.0f; });
+    };
+    if (ra && ia && opaque(ra) && opaque(ia)) ra = ia = nullptr;
+    if (a.json) {
+      nlohmann::json j = metrics_json(m);
+      if (ra && ia) j["alpha_mse"] = number(alpha_mse(ra->image, ia->image));
+      std::cout << j.dump(2) << "\n";
+    } else {
+      print_metrics(m);
+      if (ra && ia) std::printf("alpha_mse %.8g\n", alpha_mse(ra->image, ia->image));
+    }
     return 0;
   }
   if (a.frames.empty()) throw Error(Errc::InvalidArgument, "comparing sequences needs --frames A-B");
@@ -99,7 +115,7 @@ Run add_compare(CLI::App& app) {
   app.add_option("--reference-layer", a->ref_layer, "view layer of the reference");
   app.add_option("--frames", a->frames, "frame range A-B for sequences (adds temporal error)");
   add_threads_option(app, a->threads);
-  app.add_flag("--json", a->json, "JSON with keys rmse, relmse, psnr, ssim");
+  app.add_flag("--json", a->json, "JSON with keys rmse, relmse, psnr, ssim (and alpha_mse for two stills with alpha, either below 1 somewhere)");
   return [a] { return run_compare(*a); };
 }
 

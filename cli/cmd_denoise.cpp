@@ -183,10 +183,16 @@ int run_denoise(const DenoiseArgs& a) {
         continue;
       }
       std::unique_ptr<Progress> bar;  // a single frame: progress per band
+      int last = 0, runs = 0;         // the alpha's run (alpha=filter) counts again from 1
       const StageTimes t = session.run_in_bands(input_of(list[i]), output_of(list[i]), ro, wo, eo, a.band_rows,
                                                 double(a.max_memory) * 1024.0 * 1024.0, [&](int d, int all) {
                                                   if (seq) return;
-                                                  if (!bar) bar = std::make_unique<Progress>("denoise " + a.filter + " in bands", all);
+                                                  if (!bar || d <= last) {
+                                                    if (bar) bar->finish("the colour");
+                                                    bar = std::make_unique<Progress>(
+                                                        "denoise " + a.filter + " in bands" + (runs++ ? " (alpha)" : ""), all);
+                                                  }
+                                                  last = d;
                                                   bar->step(d, "statistics passes, then the filter");
                                                 });
       if (bar) bar->finish(a.output);

@@ -34,6 +34,7 @@
 #include "io/input_limits.h"
 #include "io/output_guard.h"
 #include "io/spec_window.h"
+#include "pipeline/alpha_stage.h"
 #include "pipeline/denoise_session.h"
 #include "request.h"
 #include "util/error.h"
@@ -115,6 +116,7 @@ void cache_result(const std::string& key, std::shared_ptr<const Result> r) {
 
 struct Filtered {
   mcr::Image rgb;
+  mcr::Image alpha;  // the filtered alpha; empty where the input's is kept
   std::vector<mcr::ComponentImage> components;  // with r.keep_components: the light components
   std::string notes;  // mp::notes_text of the reconstruction's notes after the run
   std::string chosen;  // mcr::choices_text: what filter auto ran
@@ -128,7 +130,7 @@ Filtered run_filter(const mp::Request& r, const std::string& settings, const std
   try {
     Filtered f;
     if (r.keep_components) mcr::check_keep_components(lease.reconstruction->filter().params());
-    f.rgb = lease.reconstruction->run(frame, {}, r.keep_components ? &f.components : nullptr);
+    f.rgb = lease.reconstruction->run(frame, {}, r.keep_components ? &f.components : nullptr, &f.alpha);
     f.notes = mp::notes_text(lease.reconstruction->notes());
     f.chosen = mcr::choices_text(lease.reconstruction->choices());
     g_history.done();
@@ -262,12 +264,13 @@ class McreconInput final : public ImageInput {
       r->width = frame.width;
       r->height = frame.height;
       r->rgba.resize(std::size_t(frame.width) * frame.height * 4);
-      // As write_result: R,G,B from the result, A from the alpha pass (1 without).
-      const mcr::Pass* alpha = frame.find(mcr::Role::Alpha);
-      const int rc = rgb.channels(), ac = alpha ? alpha->image.channels() : 0;
+      // As write_result: R,G,B from the result, A the filtered alpha, else the alpha pass (1 without).
+      const mcr::Pass* pass = frame.find(mcr::Role::Alpha);
+      const mcr::Image* alpha = !filtered.alpha.empty() ? &filtered.alpha : pass ? &pass->image : nullptr;
+      const int rc = rgb.channels(), ac = alpha ? alpha->channels() : 0;
       for (std::size_t i = 0, n = std::size_t(frame.width) * frame.height; i < n; ++i) {
         for (int c = 0; c < 3; ++c) r->rgba[i * 4 + c] = rgb.data()[i * rc + c];
-        r->rgba[i * 4 + 3] = alpha ? alpha->image.data()[i * ac] : 1.0f;
+        r->rgba[i * 4 + 3] = alpha ? alpha->data()[i * ac] : 1.0f;
       }
       result_ = r;
       cache_result(key_, std::move(r));
@@ -382,7 +385,8 @@ class McreconOutput final : public ImageOutput {
       mcr::Frame frame = mcr::frame_from_channels(shown_name_, m_spec.width, m_spec.height, names,
                                                   std::move(pixels_), request_.read);
       frame.window = mcr::window_of(m_spec);
-      const Filtered filtered = run_filter(request_, settings_, shown_name_, frame);
+      Filtered filtered = run_filter(request_, settings_, shown_name_, frame);
+      mcr::put_alpha(frame, std::move(filtered.alpha));  // what write_result writes as A
       mcr::WriteOptions wo;
       wo.keep_passes = request_.keep_passes;
       wo.compression = request_.compression;

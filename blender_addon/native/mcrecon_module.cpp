@@ -399,12 +399,22 @@ class Session {
   py::array_t<float> denoise(const ArrayPasses& a, const py::object& roi) {
     const mcr::Frame frame = frame_from_arrays(a);
     const mcr::ExecOptions eo = exec_options(threads_, roi);
-    mcr::Image out;
+    mcr::Image out, alpha;
+    const mcr::Pass* given = frame.find(Role::Alpha);
     {
       py::gil_scoped_release release;
-      out = session_.reconstruction().run(frame, eo);
+      out = session_.reconstruction().run(frame, eo, nullptr, given ? &alpha : nullptr);
     }
-    return to_numpy(std::move(out));
+    if (!given) return to_numpy(std::move(out));
+    // With an alpha given: R, G, B and the filtered alpha (the given one where it is kept).
+    const mcr::Image& cover = alpha.empty() ? given->image : alpha;
+    mcr::Image rgba(out.width(), out.height(), 4);
+    const std::size_t ac = std::size_t(cover.channels());
+    for (std::size_t i = 0, n = rgba.pixel_count(); i < n; ++i) {
+      for (std::size_t c = 0; c < 3; ++c) rgba.data()[i * 4 + c] = out.data()[i * 3 + c];
+      rgba.data()[i * 4 + 3] = cover.data()[i * ac];
+    }
+    return to_numpy(std::move(rgba));
   }
 
   py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,
@@ -521,7 +531,8 @@ PYBIND11_MODULE(mcrecon, m) {
           py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
           py::arg("normal_space") = "world", py::arg("roi") = py::none(), py::arg("diffuse_colour") = py::none(),
           py::arg("glossy_colour") = py::none(),
-          "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32. diffuse_colour / "
+          "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32, H x W x 4 with alpha "
+          "given (the alpha filtered as params alpha= says, else as given). diffuse_colour / "
           "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them).")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
@@ -554,7 +565,8 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("glossy_colour") = py::none(),
       "Filters one frame given as float32 H x W x C numpy arrays (colour RGB or RGBA, features as available; "
       "diffuse_colour / glossy_colour: Blender's Diffuse / Glossy Color, by which bmfr and accumulate tell mirrors); "
-      "returns H x W x 3 float32.");
+      "returns H x W x 3 float32, H x W x 4 with alpha given (the alpha filtered as params alpha= says, else as "
+      "given).");
 
   m.def(
       "denoise_file",

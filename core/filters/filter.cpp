@@ -13,7 +13,11 @@
 
 namespace mcr {
 
-ParamTable with_common_params(ParamTable own) { return with_preparation_params(std::move(own), PrepSteps{}); }
+ParamTable with_common_params(ParamTable own) {
+  ParamTable t = with_preparation_params(std::move(own), PrepSteps{});
+  t.push_back(alpha_param());
+  return t;
+}
 
 Filter::Filter(const FilterInfo& info) : params_(info.name, &info.params), info_(info) {}
 

@@ -115,6 +115,23 @@ double psnr(const Image& reference, const Image& image, int nthreads) {
   return psnr_of(error_sums(reference, image, nthreads));
 }
 
+double alpha_mse(const Image& reference_alpha, const Image& image_alpha) {
+  const Image &r = reference_alpha, &a = image_alpha;
+  if (r.width() != a.width() || r.height() != a.height())
+    throw Error(Errc::SizeMismatch, "alpha_mse: reference is " + std::to_string(r.width()) + "x" +
+                                        std::to_string(r.height()) + " but image is " + std::to_string(a.width()) + "x" +
+                                        std::to_string(a.height()));
+  if (r.empty() || a.empty() || r.channels() < 1 || a.channels() < 1)
+    throw Error(Errc::InvalidArgument, "alpha_mse: empty image");
+  double sum = 0.0;
+  for (std::size_t i = 0, n = r.pixel_count(); i < n; ++i) {
+    const double d = finite_or_zero(a.data()[i * std::size_t(a.channels())]) -
+                     finite_or_zero(r.data()[i * std::size_t(r.channels())]);
+    sum += d * d;
+  }
+  return sum / double(r.pixel_count());
+}
+
 double ssim(const Image& reference, const Image& image, int nthreads) {
   check_pair(reference, image, "ssim", "reference", "image");
   return metrics_detail::ssim_checked(reference, image, nthreads);

@@ -42,6 +42,10 @@ double psnr(const Image& reference, const Image& image, int nthreads = 0);
 // Symmetric in its arguments; exactly 1 for identical images.
 double ssim(const Image& reference, const Image& image, int nthreads = 0);
 
+// The alpha's (coverage's) error: mean over pixels of (a - r)^2 on the first channel of each
+// (Cycles' A; not clamped). Needs one channel or more in each, the same size (as above).
+double alpha_mse(const Image& reference_alpha, const Image& image_alpha);
+
 // Temporal instability between consecutive frames: mean over pixels of
 // |Y(current) - Y(previous)| with luminance Y = 0.2126 R + 0.7152 G + 0.0722 B (as in SVGF and
 // BMFR). Values are not clamped.

@@ -376,6 +376,7 @@ const FilterInfo& AutoFilter::static_info() {
                          "kept as it is"),
         exposure_param(),
         components_param(),
+        alpha_param(),
     };
     i.required = {Role::Colour};
     i.optional = {Role::Normal,   Role::Position,       Role::Albedo,       Role::Depth,       Role::Variance,

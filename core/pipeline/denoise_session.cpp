@@ -10,6 +10,7 @@
 #include "io/band_reader.h"
 #include "io/exr_output.h"
 #include "io/output_guard.h"
+#include "pipeline/alpha_stage.h"
 #include "pipeline/sequence_plan.h"
 #include "pipeline/tiled_run.h"
 #include "util/error.h"
@@ -145,6 +146,13 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   std::vector<Role> roles = needs.required;
   roles.insert(roles.end(), needs.optional.begin(), needs.optional.end());
   roles.push_back(Role::Alpha);  // the output's
+  Filter* alpha_filter = reconstruction_.alpha_filter();
+  if (alpha_filter) {  // what the alpha's own run reads besides
+    const PassNeeds an = alpha_filter->needs();
+    for (const auto* list : {&an.required, &an.optional})
+      for (Role r : *list)
+        if (std::find(roles.begin(), roles.end(), r) == roles.end()) roles.push_back(r);
+  }
   FileBands source(input, read, roles);
   check_passes(needs, source.layout(), "filter '" + filter.info().name + "'");
   TiledOptions o;
@@ -160,6 +168,7 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   f.result = run_tiled(filter, source, o, &notes, &f.frame);
   notes.front() += ", " + std::to_string(source.kept_channels()) + " of " + std::to_string(source.file_channels()) +
                    " channels kept";
+  if (alpha_filter) filter_alpha_in_bands(*alpha_filter, source, o, band_rows > 0 ? 0.0 : max_bytes, f.frame, notes);
   t.read_ms = source.read_ms();  // the bands' reads, interleaved with filtering
   t.filter_ms = ms_since(t0) - t.read_ms;
   t.notes = std::move(notes);
@@ -170,6 +179,28 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
     t.write_ms = ms_since(t1);
   }
   return t;
+}
+
+void DenoiseSession::filter_alpha_in_bands(Filter& alpha_filter, FileBands& source, const TiledOptions& colour,
+                                           double max_bytes, Frame& frame, std::vector<std::string>& notes) {
+  const std::string why = alpha_kept_because(reconstruction_.filter().params(), frame);
+  if (!why.empty()) {
+    if (frame.has(Role::Alpha)) notes.push_back("alpha: kept as it is (" + why + ")");
+    return;
+  }
+  TiledOptions o = colour;
+  o.keep.clear();
+  // The colour's result (RGB float) is held while the alpha runs.
+  if (max_bytes > 0)
+    o.band_rows = band_rows_for(alpha_filter, source.width(), source.height(), source.kept_channels(),
+                                max_bytes - 12.0 * double(source.width()) * double(source.height()));
+  AlphaRows rows(source);
+  std::vector<std::string> said;
+  const AlphaRange range = alpha_range(frame.image(Role::Alpha));
+  Image alpha = finish_alpha(run_tiled(alpha_filter, rows, o, &said), range, o.nthreads);
+  put_alpha(frame, std::move(alpha));
+  notes.push_back(alpha_note(alpha_filter, range));
+  for (const std::string& n : said) notes.push_back("alpha: " + n);
 }
 
 void DenoiseSession::run_sequence(const std::vector<Job>& jobs, const WriteOptions& write, const ExecOptions& exec,

@@ -11,8 +11,11 @@
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
 #include "pipeline/reconstruction.h"
+#include "pipeline/tiled_run.h"
 
 namespace mcr {
+
+class FileBands;
 
 struct StageTimes {
   double read_ms = 0, filter_ms = 0, write_ms = 0;
@@ -43,7 +46,8 @@ class DenoiseSession {
   // run() of one frame in bands of rows (pipeline/tiled_run.h): the same pixels, in bounded
   // memory; only the passes the filter reads are decoded, a band at a time. band_rows > 0
   // sets the band height; else max_bytes (> 0) chooses it (band_rows_for). progress(done,
-  // all) after each band of each pass. Throws InvalidArgument, naming the option, for what
+  // all) after each band of each pass (with alpha=filter, the alpha's run counts again from
+  // 1: pipeline/alpha_stage.h). Throws InvalidArgument, naming the option, for what
   // bands cannot do: a temporal run, components=light_passes, a region, --keep-passes,
   // --keep-components, a deep or multi-part file, loose pass files, half buffers, foveation.
   StageTimes run_in_bands(const std::string& input, const std::string& output, const ReadOptions& read,
@@ -71,6 +75,11 @@ class DenoiseSession {
                      const WriteOptions& write) const;
   void filter_into(Filtered& f, const WriteOptions& write, const ExecOptions& exec);
   static void write_filtered(const std::string& output, const Filtered& f, const WriteOptions& write);
+  // The alpha's own run over the bands of `source` after the colour's (alpha=filter): frame's
+  // alpha pass (gathered by the colour's run) becomes the filtered one. max_bytes 0: the
+  // colour's band height, else the height that fits beside the colour's result.
+  void filter_alpha_in_bands(Filter& alpha_filter, FileBands& source, const TiledOptions& colour, double max_bytes,
+                             Frame& frame, std::vector<std::string>& notes);
 
   Reconstruction reconstruction_;
 };

@@ -1,5 +1,6 @@
 #include "pipeline/reconstruction.h"
 
+#include "pipeline/alpha_stage.h"
 #include "pipeline/auto_filter.h"
 #include "pipeline/filter_catalog.h"
 #include "util/error.h"
@@ -33,6 +34,12 @@ std::unique_ptr<Filter> same_filter(const Filter& f) {
 
 }  // namespace
 
+Filter* Reconstruction::alpha_filter() {
+  if (!alpha_) return nullptr;
+  if (!alpha_->filter) alpha_->filter = make_alpha_filter(filter());
+  return alpha_->filter.get();
+}
+
 Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate) : accumulate_(accumulate) {
   if (!filter) throw Error(Errc::Internal, "Reconstruction without a filter");
   const bool split = uses_light_passes(filter->params());
@@ -59,6 +66,9 @@ Reconstruction::Reconstruction(std::unique_ptr<Filter> filter, bool accumulate) 
     }
     stages_.push_back(std::move(stage));
   }
+  const Filter& first = *stages_.front()->filter;
+  if (filters_alpha(first.params()) && !first.info().deep_input)
+    alpha_ = std::make_unique<Stage>();  // its filter made when a frame's alpha first needs it
 }
 
 PassNeeds Reconstruction::needs() const {
@@ -73,24 +83,55 @@ PassNeeds Reconstruction::needs() const {
   return n;
 }
 
-Image Reconstruction::run(const Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components) {
-  if (!accumulate_ || light_passes()) {
-    const std::lock_guard<std::mutex> lock(mutex_);
-    notes_.clear();
-    if (light_passes()) return run_components(frame, options, components);
-    return filter().execute(frame, options);
+Image Reconstruction::run(const Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components,
+                          Image* alpha) {
+  if (alpha) *alpha = Image();
+  const std::lock_guard<std::mutex> lock(mutex_);
+  notes_.clear();
+  if (accumulate_ && !light_passes()) {
+    Frame copy = frame;  // the accumulated colour replaces the copy's, not the caller's
+    Image out = run_locked(copy, options, components);
+    if (alpha) *alpha = run_alpha(copy, options);
+    return out;
   }
-  Frame copy = frame;  // the accumulated colour replaces the copy's, not the caller's
-  return run_in_place(copy, options, components);
+  Image out = light_passes() ? run_components(frame, options, components) : filter().execute(frame, options);
+  if (alpha) *alpha = run_alpha(frame, options);
+  return out;
 }
 
 Image Reconstruction::run_in_place(Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components) {
   const std::lock_guard<std::mutex> lock(mutex_);
   notes_.clear();
+  Image out = run_locked(frame, options, components);
+  put_alpha(frame, run_alpha(frame, options));
+  return out;
+}
+
+Image Reconstruction::run_locked(Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components) {
   if (light_passes()) return run_components(frame, options, components);
   if (accumulate_)  // accumulation's passes first: nothing is accumulated for a frame the filter refuses
     check_passes(needs(), frame, "filter '" + filter().info().name + "' with accumulation");
   return run_stage(*stages_.front(), frame, options);
+}
+
+Image Reconstruction::run_alpha(const Frame& frame, const ExecOptions& options) {
+  if (!alpha_) return {};
+  const std::string why = alpha_kept_because(filter().params(), frame);
+  if (!why.empty()) {
+    if (frame.has(Role::Alpha)) notes_.push_back("alpha: kept as it is (" + why + ")");
+    alpha_->accumulator.reset();  // its history would skip this frame
+    if (alpha_->filter) alpha_->filter->reset();
+    return {};
+  }
+  alpha_filter();
+  Frame grey = alpha_frame(frame);
+  const AlphaRange range = alpha_range(frame.image(Role::Alpha));
+  const std::size_t before = notes_.size();
+  Image alpha = finish_alpha(run_stage(*alpha_, grey, options), range, options.nthreads);
+  for (std::size_t k = before; k < notes_.size(); ++k) notes_[k] = "alpha: " + notes_[k];
+  notes_.push_back(alpha_note(*alpha_->filter, range));
+  for (const std::string& m : alpha_->filter->notes()) notes_.push_back("alpha: " + m);
+  return alpha;
 }
 
 Image Reconstruction::run_stage(Stage& stage, Frame& frame, const ExecOptions& options) {
@@ -163,6 +204,10 @@ void Reconstruction::reset() {
   for (auto& stage : stages_) {
     stage->accumulator.reset();
     stage->filter->reset();
+  }
+  if (alpha_) {
+    alpha_->accumulator.reset();
+    if (alpha_->filter) alpha_->filter->reset();
   }
 }
 

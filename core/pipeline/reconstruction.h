@@ -14,6 +14,10 @@
 // is turned off (the light passes are already demodulated) and the result is their
 // recombination.
 //
+// With alpha=filter (pipeline/alpha_stage.h) the alpha runs through a filter of its own after
+// the colour (its own history too): run_in_place() puts it in the frame's alpha pass, run()
+// gives it when asked.
+//
 // Shared use: run(), run_in_place(), reset() and notes() may be called from several
 // threads at once; they are serialised (a mutex held for the whole call), in the order
 // the calls take the lock. A temporal session's frame order is then the caller's
@@ -70,11 +74,18 @@ class Reconstruction {
 
   // Checks the passes (MissingPass naming the frame's file, before any work), accumulates
   // when asked, runs the filter. With light passes, `components` (when given) receives the
-  // recombined layers, which sum to the returned beauty exactly.
-  Image run(const Frame& frame, const ExecOptions& options = {}, std::vector<ComponentImage>* components = nullptr);
+  // recombined layers, which sum to the returned beauty exactly. `alpha` (when given) receives
+  // the filtered alpha (1 channel), or is left empty where the alpha is kept (alpha=keep, no
+  // alpha pass, a constant alpha: the notes say why); without it the alpha is not filtered.
+  Image run(const Frame& frame, const ExecOptions& options = {}, std::vector<ComponentImage>* components = nullptr,
+            Image* alpha = nullptr);
   // The same without copying the frame: with accumulation its colour pass's RGB becomes
-  // the accumulated one (alpha and other channels kept).
+  // the accumulated one (other channels kept), and with alpha=filter its alpha pass becomes
+  // the filtered alpha.
   Image run_in_place(Frame& frame, const ExecOptions& options = {}, std::vector<ComponentImage>* components = nullptr);
+  // alpha=filter: the alpha's own filter (pipeline/alpha_stage.h; made on first use), else
+  // null. For a run in bands, which filters the alpha itself.
+  Filter* alpha_filter();
   // Drops the history of both stages (new shot, frames out of order).
   void reset();
 
@@ -97,9 +108,15 @@ class Reconstruction {
   };
   // Accumulates frame's colour in place when asked, runs the stage's filter.
   Image run_stage(Stage& stage, Frame& frame, const ExecOptions& options);
+  // run_in_place() under the lock, the alpha aside.
+  Image run_locked(Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components);
+  // The alpha stage on the frame as the colour's filter saw it: the filtered alpha, or empty
+  // where it is kept (a note says why).
+  Image run_alpha(const Frame& frame, const ExecOptions& options);
   Image run_components(const Frame& frame, const ExecOptions& options, std::vector<ComponentImage>* components);
 
   std::vector<std::unique_ptr<Stage>> stages_;
+  std::unique_ptr<Stage> alpha_;  // alpha=filter
   bool accumulate_ = false;
   std::vector<std::string> setup_notes_;  // settings the components mode overrides
   std::vector<std::string> notes_;

@@ -102,6 +102,14 @@ ParamSpec components_param() {
                          "pass, add emission and environment as they are");
 }
 
+ParamSpec alpha_param() {
+  return ParamSpec::Enum("alpha", "filter", {"filter", "keep"},
+                         "filter = the render's alpha (its coverage: a transparent film's edges and veils, a shadow "
+                         "catcher's shadows) filtered as a grey colour by a second run of the same filter (auto: pwaf), "
+                         "without demodulation, clamped to [0, 1] (or the input's wider range); a constant alpha (an opaque render) is kept; keep = "
+                         "the input's alpha as it is");
+}
+
 namespace {
 
 Role hole_role(const std::string& mode) { return mode == "alpha" ? Role::Alpha : Role::SampleCount; }

@@ -60,6 +60,10 @@ const Image* step_back_modulation(const ParamSet& params, const Frame& frame);
 // `components` (beauty | light_passes), in every filter's table so that every front end
 // takes it by the same name; the pipeline reads it (pipeline/components.h), no filter does.
 ParamSpec components_param();
+// `alpha` (filter | keep), in the tables of the filters that take a flat frame (not the per-sample
+// ones) so that every front end takes it by the same name; the pipeline reads it
+// (pipeline/alpha_stage.h), no filter does.
+ParamSpec alpha_param();
 
 // The passes the steps need under these settings (demodulate: albedo; holes=sample_count
 // / alpha: that pass) and those they use when present (albedo_prefilter: albedo, normal,

@@ -31,6 +31,7 @@ SRC = os.environ["MCRECON_SOURCE_DIR"]
 BIN = os.environ["MCRECON_BIN"]
 ROOM = os.path.join(SRC, "samples", "data", "room", "room_16spp.exr")
 ANIM = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_####.exr")
+PRODUCT = os.path.join(SRC, "samples", "data", "product", "product_16spp.exr")
 
 
 def cli(*args, stderr=False):
@@ -83,7 +84,7 @@ def test_arrays_match_cli(tmp):
             args += ["--set", s]
         cli(*args)
         onames, opx = read_channels(out)
-        ref = opx[:, :, [onames.index(c) for c in "RGB"]]
+        ref = opx[:, :, [onames.index(c) for c in "RGBA"]]  # alpha given: RGBA back (room's: 1, kept)
         got = mcrecon.denoise(filt, params=params, **{k: passes[k] for k in used})
         assert got.dtype == np.float32 and got.shape == ref.shape, (got.dtype, got.shape, ref.shape)
         assert np.array_equal(got, ref), f"{filt}: numpy result differs from the CLI (max |d| {np.abs(got - ref).max()})"
@@ -97,12 +98,33 @@ def test_arrays_match_cli(tmp):
         print(f"{filt}: arrays, denoise_file and Session match `mcrecon denoise` bit for bit")
 
 
+def test_alpha_is_filtered_as_the_cli_does(tmp):
+    # A transparent render (Film > Transparent, a shadow catcher): the alpha filtered by a run of
+    # its own, the same bits by arrays, Session and file as by `mcrecon denoise`; alpha=keep keeps it.
+    names, px = read_channels(PRODUCT)
+    L = "ViewLayer"
+    passes = dict(colour=group(names, px, L + ".Combined", "RGB"), alpha=group(names, px, L + ".Combined", "A"),
+                  albedo=group(names, px, L + ".Denoising Albedo", "RGB"),
+                  normal=group(names, px, L + ".Denoising Normal", "XYZ"),
+                  position=group(names, px, L + ".Position", "XYZ"), depth=group(names, px, L + ".Depth", "Z"))
+    out = os.path.join(tmp, "alpha_cli.exr")
+    cli("denoise", PRODUCT, "-o", out, "-f", "pwaf")
+    onames, opx = read_channels(out)
+    ref = opx[:, :, [onames.index(c) for c in "RGBA"]]
+    assert not np.array_equal(ref[:, :, 3], passes["alpha"][:, :, 0]), "the CLI kept the alpha"
+    got = mcrecon.Session("pwaf").denoise(**passes)
+    assert got.shape == ref.shape and np.array_equal(got, ref), "Session.denoise's RGBA differs from the CLI's"
+    kept = mcrecon.denoise("pwaf", params={"alpha": "keep"}, **passes)
+    assert np.array_equal(kept[:, :, 3], passes["alpha"][:, :, 0]) and np.array_equal(kept[:, :, :3], ref[:, :, :3])
+    print("alpha: filtered alike by arrays and the CLI (alpha=keep keeps it, the colour's bits the same)")
+
+
 def test_auto_reports_its_choice(tmp):
     """filter='auto' in every entry point: listed, its table as the CLI's, and denoise_file's notes
     name the filter it ran; the output is that filter's, bit for bit (the oracle for the report)."""
     assert "auto" in mcrecon.filter_names() and mcrecon.filter_names()[-1] == "auto", mcrecon.filter_names()
     info = mcrecon.filter_info("auto")
-    assert {p["name"] for p in info["parameters"]} == {"sample_fraction", "converged", "min_gain", "exposure", "components"}, \
+    assert {p["name"] for p in info["parameters"]} == {"sample_fraction", "converged", "min_gain", "exposure", "components", "alpha"}, \
         info["parameters"]
     assert info in mcrecon.filters()
     out = os.path.join(tmp, "auto_py.exr")
@@ -179,7 +201,7 @@ def test_accumulate_matches_cli(tmp):
                         diffuse_colour=group(names, px, L + ".DiffCol", "RGB"),
                         glossy_colour=group(names, px, L + ".GlossCol", "RGB"))
         onames = read_channels(frame_path(want, f))[0]
-        ref = np.ascontiguousarray(wanted[f - 1][:, :, [onames.index(c) for c in "RGB"]])
+        ref = np.ascontiguousarray(wanted[f - 1][:, :, [onames.index(c) for c in "RGBA"]])
         assert same_bits(got, ref), f"Session(accumulate=True).denoise on arrays, frame {f} differs"
     # denoise_file: one frame, as `mcrecon denoise FILE --accumulate`.
     one = os.path.join(tmp, "acc_one.exr")
@@ -386,6 +408,7 @@ if __name__ == "__main__":
     with tempfile.TemporaryDirectory(prefix="mcrecon_py_") as tmp:
         test_filters_match_cli()
         test_arrays_match_cli(tmp)
+        test_alpha_is_filtered_as_the_cli_does(tmp)
         test_auto_reports_its_choice(tmp)
         test_accumulate_matches_cli(tmp)
         test_sequence_warmup_matches_cli(tmp)

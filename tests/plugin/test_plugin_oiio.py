@@ -29,6 +29,7 @@ import mcrecon_testutil as tu  # noqa: E402
 RGBA = ["R", "G", "B", "A"]
 SRC = tu.source_dir()
 ROOM = os.path.join(SRC, "samples", "data", "room", "room_16spp.exr")
+PRODUCT = os.path.join(SRC, "samples", "data", "product", "product_16spp.exr")  # Film > Transparent
 ANIM = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_####.exr")  # the CLI's pattern
 ANIM_OIIO = ANIM.replace("####", "%04d")  # oiiotool's: one '#' is four digits there
 OIIOTOOL = shutil.which("oiiotool") or "/usr/bin/oiiotool"
@@ -191,6 +192,18 @@ class TestMatchesCli(PluginTestBase):
                     self.assertEqual(list(inp.spec().channelnames), RGBA)
                 finally:
                     inp.close()
+
+    def test_a_transparent_renders_alpha_is_filtered_as_the_cli_does(self):
+        want = self.path("cli_alpha.exr")
+        check_ok(self.cli_denoise("pwaf", want, inp=PRODUCT))
+        self.assertFalse(same_bits(tu.read_channels(want, ["A"]), tu.read_channels(PRODUCT, ["ViewLayer.Combined.A"])),
+                         "the CLI kept the alpha")
+        got = self.path("rest_alpha.exr")
+        check_ok(oiiotool(PRODUCT + ".mcrecon?filter=pwaf", "-o", got))
+        assert_same_pixels(self, got, want, "alpha via ?filter=")
+        got = self.path("out_alpha.exr")
+        check_ok(oiiotool(PRODUCT, "--attrib", "mcrecon:filter", "pwaf", "-o:fileformatname=mcrecon", got))
+        assert_same_pixels(self, got, want, "alpha via -o:fileformatname=mcrecon")
 
     def test_output_metadata_survives_a_copy_with_the_plugin_loaded(self):
         # OIIO drops "<format>:" attributes of a known format when writing another one, so

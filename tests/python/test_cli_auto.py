@@ -69,9 +69,10 @@ class AutoCliTest(unittest.TestCase):
         self.assertEqual(auto["required_passes"], ["colour"])
         self.assertFalse(auto["temporal"])
         params = {p["name"]: p for p in auto["parameters"]}
-        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "exposure", "components"})
+        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "exposure", "components", "alpha"})
         self.assertEqual(params.pop("components")["choices"], ["beauty", "light_passes"])  # every filter's
         self.assertEqual(params.pop("exposure")["choices"], ["auto", "off"])  # every image filter's
+        self.assertEqual(params.pop("alpha")["choices"], ["filter", "keep"])  # every flat-frame filter's
         for p in params.values():
             self.assertEqual(p["type"], "float")
             self.assertLessEqual(p["min"], p["default"])

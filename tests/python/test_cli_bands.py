@@ -14,6 +14,7 @@ import mcrecon_testutil as tu
 
 ROOM = os.path.join(tu.source_dir(), "samples", "data", "room", "room_16spp.exr")
 ANIM = os.path.join(tu.source_dir(), "samples", "data", "anim", "anim_1spp_####.exr")
+PRODUCT = os.path.join(tu.source_dir(), "samples", "data", "product", "product_16spp.exr")
 
 
 def image(path):
@@ -44,6 +45,21 @@ class BandsTest(unittest.TestCase):
             for key in ("mcreconFilter", "mcreconParameters"):
                 self.assertEqual(sa.getattribute(key), sb.getattribute(key), f)
             self.assertFalse([n for n in os.listdir(self.tmp) if n.startswith(".")], "no temp file left")
+
+    def test_a_transparent_renders_alpha_is_filtered_in_bands_of_its_own(self):
+        # alpha=filter: after the colour's bands, the alpha's run over the same bands; the whole
+        # frame's alpha bit for bit, and not the input's.
+        for f in ("bilateral", "pwaf"):
+            whole, banded = self.out(f + "_whole.exr"), self.out(f + "_bands.exr")
+            tu.run_cli("denoise", PRODUCT, "-o", whole, "-f", f)
+            proc = tu.run_cli("denoise", PRODUCT, "-o", banded, "-f", f, "--band-rows", "64", "-v")
+            self.assertIn("alpha: filtered by " + f, proc.stderr)
+            self.assertIn("alpha: 3 bands of 64 rows", proc.stderr)
+            a, sa = image(whole)
+            b, _ = image(banded)
+            np.testing.assert_array_equal(a, b, err_msg=f)
+            given, sg = image(PRODUCT)
+            self.assertFalse(np.array_equal(b[:, :, 3], given[:, :, list(sg.channelnames).index("ViewLayer.Combined.A")]))
 
     def test_max_memory_chooses_bands_and_says_when_too_little(self):
         done = tu.run_cli("denoise", ROOM, "-o", self.out("m.exr"), "-f", "atrous", "--max-memory", "400", "-v")

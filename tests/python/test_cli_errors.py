@@ -475,7 +475,7 @@ class CliErrorTest(_TempDirCase):
 
 
 class CliDenoiseTest(_TempDirCase):
-    def test_box_writes_rgba_float_with_input_alpha(self):
+    def test_box_writes_rgba_float_with_the_alpha_filtered_alike(self):
         out = os.path.join(self.out, "den.exr")
         # The numpy oracle is the box alone: without the step back toward the input (on by default).
         proc = self.run_cli("denoise", self.ml, "-o", out, "-f", "box", "--set", "radius=1", "--set", "step_back=false")
@@ -488,7 +488,11 @@ class CliDenoiseTest(_TempDirCase):
         self.assertEqual(spec.alpha_channel, 3)
         want = numpy_box(self.ml_pixels[:, :, 0:3], 1)
         np.testing.assert_allclose(px[:, :, :3], want, rtol=1e-6, atol=0)
-        np.testing.assert_array_equal(px[:, :, 3], self.ml_pixels[:, :, 3])
+        # alpha=filter: the alpha through the same box (its values within the input's range)
+        np.testing.assert_allclose(px[:, :, 3], numpy_box(self.ml_pixels[:, :, 3:4], 1)[:, :, 0], rtol=1e-6, atol=0)
+        proc = self.run_cli("denoise", self.ml, "-o", out, "-f", "box", "--set", "radius=1", "--set", "alpha=keep")
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        np.testing.assert_array_equal(image_spec_and_pixels(out)[1][:, :, 3], self.ml_pixels[:, :, 3])
         self.assertEqual(spec.get_string_attribute("mcreconFilter"), "box")
 
     def test_compression_is_written_as_asked(self):

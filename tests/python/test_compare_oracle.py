@@ -210,6 +210,19 @@ class CompareOracleTest(unittest.TestCase):
         self.assert_metrics_close(self.cli_compare(ref_path, noisy_path), expected,
                                   "room_16spp vs room_ref (multilayer)")
 
+    def test_a_transparent_pair_also_gets_its_alphas_error(self):
+        # Film > Transparent: alpha_mse, the mean of (A - A_ref)^2, besides the four (numpy oracle).
+        d = os.path.join(tu.source_dir(), "samples", "data", "product")
+        ref_path, noisy_path = os.path.join(d, "product_ref.exr"), os.path.join(d, "product_16spp.exr")
+        result = tu.run_cli_json("compare", ref_path, noisy_path, "--json")
+        self.assertEqual(set(result), {"rmse", "relmse", "psnr", "ssim", "alpha_mse"})
+        a = "ViewLayer.Combined.A"
+        want = np.mean((tu.read_channels(noisy_path, [a]).astype(np.float64) -
+                        tu.read_channels(ref_path, [a]).astype(np.float64)) ** 2)
+        self.assertAlmostEqual(result["alpha_mse"], want, delta=1e-9 * want)
+        text = tu.run_cli("compare", ref_path, noisy_path).stdout
+        self.assertRegex(text, r"(?m)^alpha_mse ")
+
     def test_multilayer_against_plain_rgb(self):
         ref_path, noisy_path = self._room_paths()
         ref = tu.read_channels(ref_path, COMBINED)

@@ -75,6 +75,20 @@ TEST(MetricsTest, RelmseUsesReferenceInDenominatorPerChannel) {
   EXPECT_NEAR(relmse(ref, img), expected, 1e-6);  // float inputs: ~1e-7 relative
 }
 
+TEST(MetricsTest, AlphaMseIsTheMeanSquareOfTheFirstChannelsDifference) {
+  Image r(2, 2, 1), a(2, 2, 2);
+  const float rv[4] = {0.0f, 1.0f, 0.5f, 0.25f}, av[4] = {0.5f, 1.0f, 0.0f, std::numeric_limits<float>::quiet_NaN()};
+  for (int i = 0; i < 4; ++i) {
+    r.data()[i] = rv[i];
+    a.data()[2 * i] = av[i];
+    a.data()[2 * i + 1] = 7.0f;  // not the alpha
+  }
+  // (0.5^2 + 0 + 0.5^2 + 0.25^2 (NaN read as 0)) / 4
+  EXPECT_DOUBLE_EQ(alpha_mse(r, a), (0.25 + 0.25 + 0.0625) / 4.0);
+  EXPECT_DOUBLE_EQ(alpha_mse(a, a), 0.0);
+  expect_error(Errc::SizeMismatch, {"alpha_mse", "2x2", "3x2"}, [&] { alpha_mse(r, Image(3, 2, 1)); });
+}
+
 TEST(MetricsTest, SsimOfTwoConstantImagesMatchesClosedForm) {
   const double a = 0.2, b = 0.7;
   const Image x = constant_image(13, 9, float(a), float(a), float(a));

@@ -116,6 +116,7 @@ const FilterInfo& BmfrFilter::static_info() {
         ParamSpec::Float("cut_fraction", 0.9, 0.0, 1.0,
                          "camera cut: history restarts when more than this fraction of pixels lose every tap"),
     }, i.steps);
+    i.params.push_back(alpha_param());
     // Its phase I sample limit does the firefly step's job, on the accumulated signal and at
     // a fraction of its cost (separable sums, not a two-pass 7x7 window per pixel).
     for (ParamSpec& p : i.params)

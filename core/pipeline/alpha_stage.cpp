@@ -1,0 +1,95 @@
+#include "pipeline/alpha_stage.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "pipeline/filter_catalog.h"
+#include "util/parallel.h"
+
+namespace mcr {
+
+bool filters_alpha(const ParamSet& params) { return params.has("alpha") && params.get_enum("alpha") == "filter"; }
+
+std::unique_ptr<Filter> make_alpha_filter(const Filter& colour_filter) {
+  const std::string name = colour_filter.info().name == "auto" ? "pwaf" : colour_filter.info().name;
+  std::unique_ptr<Filter> f = make_catalog_filter(name);
+  if (name == colour_filter.info().name)
+    for (const auto& kv : colour_filter.params().values())
+      if (colour_filter.params().was_set(kv.first)) f->set(kv.first, kv.second);
+  // Coverage is not lit through the albedo: the preparation's demodulation and bmfr's own off.
+  for (const char* p : {"demodulate", "albedo_demodulation"})
+    if (f->params().has(p)) f->set(p, false);
+  if (f->params().has("components")) f->set("components", std::string("beauty"));
+  f->commit();
+  return f;
+}
+
+std::string alpha_kept_because(const ParamSet& params, const Frame& frame) {
+  if (params.has("holes") && params.get_enum("holes") == "alpha")
+    return "holes=alpha (the alpha marks the sampled pixels)";
+  const Pass* alpha = frame.find(Role::Alpha);
+  if (!alpha || alpha->image.pixel_count() == 0) return "no alpha pass";
+  const Image& a = alpha->image;
+  const std::size_t n = a.pixel_count(), ch = std::size_t(a.channels());
+  const float first = a.data()[0];
+  for (std::size_t i = 1; i < n; ++i)
+    if (!(a.data()[i * ch] == first)) return "";
+  return "alpha " + rounded_text(first, 4) + " everywhere";
+}
+
+Frame alpha_frame(const Frame& frame) {
+  Frame f = frame;
+  const Pass& colour = frame.get(Role::Colour);
+  const Pass& alpha = frame.get(Role::Alpha);
+  Image grey(frame.width, frame.height, 3);
+  const std::size_t ac = std::size_t(alpha.image.channels());
+  for (std::size_t i = 0, n = grey.pixel_count(); i < n; ++i)
+    grey.data()[i * 3] = grey.data()[i * 3 + 1] = grey.data()[i * 3 + 2] = alpha.image.data()[i * ac];
+  f.passes.erase(std::remove_if(f.passes.begin(), f.passes.end(),
+                                [](const Pass& p) {
+                                  return p.role == Role::Variance || p.role == Role::Colour || p.role == Role::Alpha;
+                                }),
+                 f.passes.end());
+  Pass c = with_pixels(colour, std::move(grey));
+  c.channels.resize(std::min<std::size_t>(c.channels.size(), 3));
+  f.passes.insert(f.passes.begin(), std::move(c));
+  return f;
+}
+
+AlphaRange alpha_range(const Image& alpha) {
+  AlphaRange r;
+  const std::size_t ch = std::size_t(alpha.channels());
+  for (std::size_t i = 0, n = alpha.pixel_count(); i < n; ++i) {
+    const float v = alpha.data()[i * ch];
+    if (!std::isfinite(v)) continue;
+    r.lo = std::min(r.lo, v);
+    r.hi = std::max(r.hi, v);
+  }
+  return r;
+}
+
+Image finish_alpha(const Image& filtered, AlphaRange range, int nthreads) {
+  const int w = filtered.width(), h = filtered.height(), ch = filtered.channels();
+  Image out(w, h, 1);
+  parallel_rows(0, h, nthreads, [&](int y) {
+    const float* in = filtered.pixel(0, y);
+    float* o = out.pixel(0, y);
+    for (int x = 0; x < w; ++x) {
+      const float v = in[x * ch];
+      o[x] = std::isfinite(v) ? std::clamp(v, range.lo, range.hi) : range.lo;
+    }
+  });
+  return out;
+}
+
+std::string alpha_note(const Filter& alpha_filter, AlphaRange range) {
+  return "alpha: filtered by " + alpha_filter.info().name + " as a grey colour (demodulation off), clamped to [" +
+         rounded_text(range.lo, 4) + ", " + rounded_text(range.hi, 4) + "]";
+}
+
+void put_alpha(Frame& frame, Image alpha) {
+  if (alpha.empty()) return;
+  frame.passes[std::size_t(&frame.get(Role::Alpha) - frame.passes.data())].image = std::move(alpha);
+}
+
+}  // namespace mcr
