@@ -5,6 +5,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <vector>
 
@@ -62,6 +63,27 @@ TEST(Reconstruction, AccumulationOfAStaticShotIsTheClosedForm) {
     rec.reset();
     const Frame f = static_frame(w, h, 50);
     EXPECT_EQ(rec.run(f).storage(), f.image(Role::Colour).storage());
+  }
+}
+
+// alpha=filter with accumulation: the alpha keeps a history of its own, the same closed form.
+TEST(Reconstruction, TheAlphaIsAccumulatedByItsOwnHistory) {
+  const int w = 13, h = 9, frames = 7;
+  const double weight_floor = 0.2;
+  Reconstruction rec(make_committed_filter("box", {{"radius", "0"}, {"firefly_k", "0"}}), true);
+  std::vector<double> expect(std::size_t(w) * h, 0.0);
+  for (int k = 1; k <= frames; ++k) {
+    Frame f = static_frame(w, h, k);
+    const Image coverage = static_frame(w, h, 100 + k).image(Role::Colour).channel_range(0, 1);
+    testutil::add_pass(f, Role::Alpha, coverage);
+    Image alpha;
+    rec.run(f, {}, nullptr, &alpha);
+    ASSERT_EQ(alpha.pixel_count(), expect.size());
+    const double wgt = std::max(1.0 / k, weight_floor);
+    for (std::size_t i = 0; i < expect.size(); ++i) {
+      expect[i] = (1.0 - wgt) * expect[i] + wgt * double(coverage.storage()[i]);
+      ASSERT_NEAR(alpha.storage()[i], expect[i], 2e-6) << "frame " << k << " pixel " << i;
+    }
   }
 }
 
