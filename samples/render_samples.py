@@ -77,17 +77,23 @@ SCENES = {
                          "vase, a brushed-steel cube and a matte box under a soft key light, a rim "
                          "light and a sky only the glass and metal show; the soft shadows live in "
                          "the alpha; held out: never used to choose settings."),
+    "cutout": ("still", "studio's objects as a cut-out on a transparent background (Film > "
+                        "Transparent, no table or wall): the fur's fringe of sub-pixel hair, the "
+                        "back-lit leaves' edges and the flame are partial coverage against alpha "
+                        "0; held out: never used to choose settings."),
 }
 ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence",
          "night", "studio",
-         "product"]
+         "product", "cutout"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
          "chrome": "report", "orbit": "report", "fog": "report", "fence": "report",
-         "night": "report", "studio": "report", "product": "report"}
+         "night": "report", "studio": "report", "product": "report",
+         "cutout": "report"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
-HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16], "studio": [16]}
+HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16], "studio": [16],
+          "cutout": [16]}
 
 # Channel groups Blender writes (view layer "ViewLayer", compositing off).
 NOISY_PASSES = ["Combined", "Denoising Albedo", "Denoising Depth", "Denoising Normal", "Depth",
