@@ -197,7 +197,7 @@ TEST(AutoFilter, TheHeldOutScoresChooseWellOnTheTuneStills) {
 TEST(AutoFilter, TheReferencesAreKeptAsTheyAre) {
   // night: a street at its physical brightness, its fine detail read as noise once the exposure
   // step has scaled it (the candidates rank above the input, the check alone passed pwaf).
-  for (const char* scene : {"room", "glossy", "sunlit", "dof", "showroom", "wall", "fog", "fence", "night", "studio", "product"}) {
+  for (const char* scene : {"room", "glossy", "sunlit", "dof", "showroom", "wall", "fog", "fence", "night", "studio", "product", "cutout"}) {
     SCOPED_TRACE(scene);
     const Frame f = read_frame(std::string(MCRECON_SOURCE_DIR) + "/samples/data/" + scene + "/" + scene + "_ref.exr");
     AutoFilter a;
