@@ -67,6 +67,15 @@ Request make_request(const std::string& source, const KeyValues& settings, bool 
       r.read.layer = value;
     } else if (role_from_name(key)) {
       r.read.overrides.push_back(parse_pass_override(key + "=" + value));  // the CLI's --pass checks
+    } else if (key == "half") {
+      // The other half buffer of the source file: the input side reads both (the output side
+      // is handed pixels, not a file).
+      if (output_side)
+        throw Error(Errc::InvalidArgument, "half=" + value + " for '" + source + "': the output plugin is handed the "
+                                           "pixels, not the file; read the render through the input plugin "
+                                           "(x.exr.mcrecon?filter=F&half=OTHER.exr)");
+      if (value.empty()) throw Error(Errc::InvalidArgument, "half= for '" + source + "' names no file");
+      r.read.second_half = value;
     } else if (key == "accumulate") {
       r.accumulate = parse_switch(key, value, source);
     } else if (output_side && key == "keep_passes") {
@@ -94,6 +103,7 @@ std::unique_ptr<Reconstruction> make_reconstruction(const Request& r) {
 std::string settings_key(const Request& r, const std::string& canonical_params) {
   std::string key = "filter=" + r.filter + " layer=" + r.read.layer;
   for (const PassOverride& o : r.read.overrides) key += std::string(" ") + role_name(o.role) + "=" + o.value;
+  key += " half=" + r.read.second_half;
   key += " keep_passes=" + std::to_string(int(r.keep_passes)) + " accumulate=" + std::to_string(int(r.accumulate)) +
          " " + canonical_params;
   return key;

@@ -24,7 +24,7 @@ struct Request {
   std::string source;   // the render to read ("x.exr" for "x.exr.mcrecon?...")
   std::string filter;   // a catalog name: a registered filter or auto (pipeline/filter_catalog.h)
   KeyValues params;     // filter parameters, in the order given (last one wins)
-  ReadOptions read;     // layer= and ROLE= pass overrides
+  ReadOptions read;     // layer=, ROLE= pass overrides and half=
   bool accumulate = false;       // accumulation stage before the filter (the CLI's --accumulate)
   bool keep_passes = false;      // output side only (mcrecon:keep_passes)
   bool keep_components = false;  // output side only (mcrecon:keep_components; needs components=light_passes)
@@ -39,7 +39,8 @@ std::pair<std::string, KeyValues> split_name(const std::string& name);
 // Builds a request from key=value settings, in order: first `config` (the
 // "mcrecon:" attributes of --iconfig or of the output spec, prefix removed), then
 // the name's query. Keys: filter, layer, a pass role (colour, albedo, normal, ...,
-// as the CLI's --pass ROLE=VALUE), accumulate (0, 1, true, false), keep_passes,
+// as the CLI's --pass ROLE=VALUE), half (input only: the other half buffer, as --half),
+// accumulate (0, 1, true, false), keep_passes,
 // keep_components and compression (output only), anything else is a parameter of the filter's table
 // (checked by the filter). Throws InvalidArgument (no filter, bad role value, bad
 // accumulate or keep_passes).

@@ -419,8 +419,10 @@ class Session {
 
   py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,
                         const py::dict& passes, bool keep_passes, bool keep_components = false,
-                        const py::object& display = py::none(), int max_memory_mb = 0) {
-    const mcr::ReadOptions ro = read_options(layer, passes);
+                        const py::object& display = py::none(), int max_memory_mb = 0,
+                        const std::optional<std::string>& half = std::nullopt) {
+    mcr::ReadOptions ro = read_options(layer, passes);
+    if (half) ro.second_half = *half;
     const mcr::WriteOptions wo = write_options(keep_passes, keep_components, display);
     mcr::ReadOptions r = ro;
     r.keep_extra = keep_passes;
@@ -536,7 +538,7 @@ PYBIND11_MODULE(mcrecon, m) {
           "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them).")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
-           py::arg("display") = py::none(), py::arg("max_memory_mb") = 0,
+           py::arg("display") = py::none(), py::arg("max_memory_mb") = 0, py::arg("half") = py::none(),
            "Reads a render (multilayer EXR), filters it and writes output (temp + rename) in the format its "
            "extension names (.exr; .png, .jpg, .tif through the OpenColorIO view in display=, e.g. "
            "{'view': 'Filmic', 'exposure': 0.5}); returns stage timings "
@@ -544,7 +546,8 @@ PYBIND11_MODULE(mcrecon, m) {
            "the same pixels (as --max-memory). "
            "passes: {role: channel group or file}, e.g. {'colour': 'Composite.Combined'}. keep_components=True "
            "(with params components='light_passes'): each denoised light component as its own layer, as "
-           "--keep-components.");
+           "--keep-components. half: the other half buffer of the input (the same render's samples split in two, "
+           "Blender's sample_offset), as --half: their mean is filtered, with the noise from their difference.");
 
   m.def(
       "denoise",
@@ -572,15 +575,17 @@ PYBIND11_MODULE(mcrecon, m) {
       "denoise_file",
       [](const std::string& input, const std::string& output, const std::string& filter, const py::dict& params,
          const std::optional<std::string>& layer, const py::dict& passes, bool keep_passes, int threads,
-         const py::object& accumulate, bool keep_components, const py::object& display, int max_memory_mb) {
+         const py::object& accumulate, bool keep_components, const py::object& display, int max_memory_mb,
+         const std::optional<std::string>& half) {
         Session s(filter, params, threads, accumulate);
-        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components, display, max_memory_mb);
+        return s.denoise_file(input, output, layer, passes, keep_passes, keep_components, display, max_memory_mb, half);
       },
       py::arg("input"), py::arg("output"), py::arg("filter"), py::arg("params") = py::dict(),
       py::arg("layer") = py::none(), py::arg("passes") = py::dict(), py::arg("keep_passes") = false,
       py::arg("threads") = 0, py::arg("accumulate") = false, py::arg("keep_components") = false,
-      py::arg("display") = py::none(), py::arg("max_memory_mb") = 0,
-      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate; "
+      py::arg("display") = py::none(), py::arg("max_memory_mb") = 0, py::arg("half") = py::none(),
+      "Same as `mcrecon denoise INPUT -o OUTPUT -f FILTER --set k=v ...` (accumulate=True: --accumulate; half=: "
+      "--half, the other half buffer; "
       "keep_components=True: --keep-components, with params={'components': 'light_passes'}; display={'view': "
       "'Filmic', 'look': ..., 'exposure': ..., 'gamma': ..., 'bit_depth': 8 or 16}: --view etc. for a "
       ".png/.jpg/.tif output); returns "

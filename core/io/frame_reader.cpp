@@ -423,6 +423,10 @@ void check_image_file(const std::string& path) {
 
 Frame read_frame(const std::string& path, const ReadOptions& options) {
   if (!options.second_half.empty()) {
+    std::error_code ec;
+    if (std::filesystem::equivalent(options.second_half, path, ec))
+      throw Error(Errc::InvalidArgument, "the second half buffer '" + options.second_half + "' is the input '" + path +
+                                             "' itself: give the other half buffer");
     ReadOptions one = options;
     one.second_half.clear();
     return combine_halves(frame_from_raw(read_raw(path), path, one), read_frame(options.second_half, one));

@@ -32,6 +32,8 @@ BIN = os.environ["MCRECON_BIN"]
 ROOM = os.path.join(SRC, "samples", "data", "room", "room_16spp.exr")
 ANIM = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_####.exr")
 PRODUCT = os.path.join(SRC, "samples", "data", "product", "product_16spp.exr")
+FENCE_HALF0 = os.path.join(SRC, "samples", "data", "fence", "fence_16spp_half0.exr")
+FENCE_HALF1 = os.path.join(SRC, "samples", "data", "fence", "fence_16spp_half1.exr")
 
 
 def cli(*args, stderr=False):
@@ -117,6 +119,28 @@ def test_alpha_is_filtered_as_the_cli_does(tmp):
     kept = mcrecon.denoise("pwaf", params={"alpha": "keep"}, **passes)
     assert np.array_equal(kept[:, :, 3], passes["alpha"][:, :, 0]) and np.array_equal(kept[:, :, :3], ref[:, :, :3])
     print("alpha: filtered alike by arrays and the CLI (alpha=keep keeps it, the colour's bits the same)")
+
+
+def test_halves_match_cli(tmp):
+    # half= as --half: the mean of the two half buffers filtered, with the noise from their
+    # difference; the same bits by Session and by the module function; the input as its own half,
+    # or a missing one, is refused by name.
+    want = os.path.join(tmp, "half_cli.exr")
+    cli("denoise", FENCE_HALF0, "--half", FENCE_HALF1, "-o", want, "-f", "pwaf")
+    expected = read_channels(want)[1]
+    got = os.path.join(tmp, "half_py.exr")
+    mcrecon.denoise_file(FENCE_HALF0, got, "pwaf", half=FENCE_HALF1)
+    assert np.array_equal(read_channels(got)[1], expected), "denoise_file(half=) differs from --half"
+    mcrecon.Session("pwaf").denoise_file(FENCE_HALF0, got, half=FENCE_HALF1)
+    assert np.array_equal(read_channels(got)[1], expected), "Session.denoise_file(half=) differs from --half"
+    one = os.path.join(tmp, "half_one.exr")
+    mcrecon.denoise_file(FENCE_HALF0, one, "pwaf")
+    assert not np.array_equal(read_channels(one)[1], expected), "half= changed nothing"
+    expect_error(lambda: mcrecon.denoise_file(FENCE_HALF0, got, "pwaf", half=FENCE_HALF0), "invalid_argument",
+                 "is the input", FENCE_HALF0)
+    expect_error(lambda: mcrecon.denoise_file(FENCE_HALF0, got, "pwaf", half=os.path.join(tmp, "none.exr")),
+                 "file_not_found", "none.exr")
+    print("half=: denoise_file and Session match `mcrecon denoise --half` bit for bit")
 
 
 def test_auto_reports_its_choice(tmp):
@@ -409,6 +433,7 @@ if __name__ == "__main__":
         test_filters_match_cli()
         test_arrays_match_cli(tmp)
         test_alpha_is_filtered_as_the_cli_does(tmp)
+        test_halves_match_cli(tmp)
         test_auto_reports_its_choice(tmp)
         test_accumulate_matches_cli(tmp)
         test_sequence_warmup_matches_cli(tmp)

@@ -74,6 +74,16 @@ TEST(PluginRequest, AccumulateOnBothSidesAndInTheSettingsKey) {
   EXPECT_EQ(make_reconstruction(on)->parameters_text().rfind("accumulate=true ", 0), 0u);
 }
 
+TEST(PluginRequest, HalfNamesTheOtherHalfBufferOnTheInputSideOnly) {
+  const Request r = make_request("h0.exr", {{"filter", "box"}, {"half", "h1.exr"}}, false);
+  EXPECT_EQ(r.read.second_half, "h1.exr");
+  EXPECT_TRUE(r.params.empty());
+  EXPECT_NE(settings_key(r, ""), settings_key(make_request("h0.exr", {{"filter", "box"}}, false), ""));
+  EXPECT_EQ(code_of([] { make_request("h0.exr", {{"filter", "box"}, {"half", "h1.exr"}}, true); }),
+            Errc::InvalidArgument);  // the output side is handed pixels
+  EXPECT_EQ(code_of([] { make_request("h0.exr", {{"filter", "box"}, {"half", ""}}, false); }), Errc::InvalidArgument);
+}
+
 TEST(PluginRequest, BadSwitchValuesNameTheSettingAndTheText) {
   for (const char* key : {"accumulate", "keep_passes"}) {
     try {

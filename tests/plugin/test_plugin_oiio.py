@@ -30,6 +30,8 @@ RGBA = ["R", "G", "B", "A"]
 SRC = tu.source_dir()
 ROOM = os.path.join(SRC, "samples", "data", "room", "room_16spp.exr")
 PRODUCT = os.path.join(SRC, "samples", "data", "product", "product_16spp.exr")  # Film > Transparent
+FENCE_HALF0 = os.path.join(SRC, "samples", "data", "fence", "fence_16spp_half0.exr")
+FENCE_HALF1 = os.path.join(SRC, "samples", "data", "fence", "fence_16spp_half1.exr")
 ANIM = os.path.join(SRC, "samples", "data", "anim", "anim_1spp_####.exr")  # the CLI's pattern
 ANIM_OIIO = ANIM.replace("####", "%04d")  # oiiotool's: one '#' is four digits there
 OIIOTOOL = shutil.which("oiiotool") or "/usr/bin/oiiotool"
@@ -204,6 +206,17 @@ class TestMatchesCli(PluginTestBase):
         got = self.path("out_alpha.exr")
         check_ok(oiiotool(PRODUCT, "--attrib", "mcrecon:filter", "pwaf", "-o:fileformatname=mcrecon", got))
         assert_same_pixels(self, got, want, "alpha via -o:fileformatname=mcrecon")
+
+    def test_half_reads_the_other_half_buffer_as_the_cli_does(self):
+        want = self.path("cli_half.exr")
+        check_ok(self.cli_denoise("pwaf", want, "--half", FENCE_HALF1, inp=FENCE_HALF0))
+        got = self.path("rest_half.exr")
+        check_ok(oiiotool(FENCE_HALF0 + ".mcrecon?filter=pwaf&half=" + FENCE_HALF1, "-o", got))
+        assert_same_pixels(self, got, want, "?half=")
+        proc = oiiotool(FENCE_HALF0, "--attrib", "mcrecon:filter", "pwaf", "--attrib", "mcrecon:half", FENCE_HALF1,
+                        "-o:fileformatname=mcrecon", self.path("out_half.exr"))
+        self.assertNotEqual(proc.returncode, 0)
+        self.assertIn("input plugin", proc.stdout + proc.stderr)
 
     def test_output_metadata_survives_a_copy_with_the_plugin_loaded(self):
         # OIIO drops "<format>:" attributes of a known format when writing another one, so
