@@ -37,22 +37,37 @@ std::string alpha_kept_because(const ParamSet& params, const Frame& frame) {
   return "alpha " + rounded_text(first, 4) + " everywhere";
 }
 
+namespace {
+
+// The light passes: only components=light_passes reads them (the alpha's run is the beauty's).
+bool light_pass(Role r) {
+  switch (r) {
+    case Role::DiffuseDirect: case Role::DiffuseIndirect: case Role::GlossyDirect: case Role::GlossyIndirect:
+    case Role::TransmissionDirect: case Role::TransmissionIndirect: case Role::TransmissionColour:
+    case Role::Emission: case Role::Environment:
+      return true;
+    default:
+      return false;
+  }
+}
+
+}  // namespace
+
 Frame alpha_frame(const Frame& frame) {
-  Frame f = frame;
+  Frame f = frame.header(frame.width, frame.height);
+  f.window = frame.window;
   const Pass& colour = frame.get(Role::Colour);
   const Pass& alpha = frame.get(Role::Alpha);
   Image grey(frame.width, frame.height, 3);
   const std::size_t ac = std::size_t(alpha.image.channels());
   for (std::size_t i = 0, n = grey.pixel_count(); i < n; ++i)
     grey.data()[i * 3] = grey.data()[i * 3 + 1] = grey.data()[i * 3 + 2] = alpha.image.data()[i * ac];
-  f.passes.erase(std::remove_if(f.passes.begin(), f.passes.end(),
-                                [](const Pass& p) {
-                                  return p.role == Role::Variance || p.role == Role::Colour || p.role == Role::Alpha;
-                                }),
-                 f.passes.end());
   Pass c = with_pixels(colour, std::move(grey));
   c.channels.resize(std::min<std::size_t>(c.channels.size(), 3));
-  f.passes.insert(f.passes.begin(), std::move(c));
+  f.passes.push_back(std::move(c));
+  for (const Pass& p : frame.passes)
+    if (p.role != Role::Colour && p.role != Role::Alpha && p.role != Role::Variance && !light_pass(p.role))
+      f.passes.push_back(p);
   return f;
 }
 

@@ -33,9 +33,10 @@ std::unique_ptr<Filter> make_alpha_filter(const Filter& colour_filter);
 // everywhere (its value named), holes=alpha (the alpha marks the sampled pixels, not coverage).
 std::string alpha_kept_because(const ParamSet& params, const Frame& frame);
 
-// The frame the alpha's filter runs on: the colour pass replaced by the alpha in R, G and B;
-// the alpha pass by 0 where nothing was rendered (alpha 0, colour 0), else 1; no variance pass
-// (it is the colour's). Every other pass as it is.
+// The frame the alpha's filter runs on: the colour pass replaced by the alpha in R, G and B, and
+// every feature pass, but not the alpha (the filter would keep its 0s), the variance (the
+// colour's), the light passes (the alpha's run is a beauty run) or the channels without a role (a
+// copy of those would double a many-pass frame's memory for nothing).
 Frame alpha_frame(const Frame& frame);
 
 // The range the filtered alpha is clamped to: [0, 1], widened to the input's least and greatest
