@@ -253,25 +253,17 @@ class McreconInput final : public ImageInput {
     try {
       std::lock_guard<std::mutex> run(g_run_mutex);
       if ((result_ = cached_result(key_))) return true;  // another reader was faster
-      const mcr::Frame frame = mcr::read_frame(request_.source, request_.read);
+      mcr::Frame frame = mcr::read_frame(request_.source, request_.read);
       if (frame.width != m_spec.width || frame.height != m_spec.height)
         throw mcr::Error(Errc::ReadFailed, "'" + request_.source + "' changed while it was read");
-      const Filtered filtered = run_filter(request_, settings_, request_.source, frame);
-      const mcr::Image& rgb = filtered.rgb;
+      Filtered filtered = run_filter(request_, settings_, request_.source, frame);
+      mcr::put_alpha(frame, std::move(filtered.alpha));
       auto r = std::make_shared<Result>();
       r->notes = filtered.notes;
       r->chosen = filtered.chosen;
       r->width = frame.width;
       r->height = frame.height;
-      r->rgba.resize(std::size_t(frame.width) * frame.height * 4);
-      // As write_result: R,G,B from the result, A the filtered alpha, else the alpha pass (1 without).
-      const mcr::Pass* pass = frame.find(mcr::Role::Alpha);
-      const mcr::Image* alpha = !filtered.alpha.empty() ? &filtered.alpha : pass ? &pass->image : nullptr;
-      const int rc = rgb.channels(), ac = alpha ? alpha->channels() : 0;
-      for (std::size_t i = 0, n = std::size_t(frame.width) * frame.height; i < n; ++i) {
-        for (int c = 0; c < 3; ++c) r->rgba[i * 4 + c] = rgb.data()[i * rc + c];
-        r->rgba[i * 4 + 3] = alpha ? alpha->data()[i * ac] : 1.0f;
-      }
+      r->rgba = std::move(mcr::rgba_result(filtered.rgb, frame).storage());  // as write_result writes it
       result_ = r;
       cache_result(key_, std::move(r));
       return true;

@@ -20,6 +20,7 @@
 #include "io/deep_writer.h"
 #include "io/frame_reader.h"
 #include "io/frame_writer.h"
+#include "pipeline/alpha_stage.h"
 #include "io/output_guard.h"
 #include "io/sequence.h"
 #include "pipeline/sequence_plan.h"
@@ -397,24 +398,18 @@ class Session {
   }
 
   py::array_t<float> denoise(const ArrayPasses& a, const py::object& roi) {
-    const mcr::Frame frame = frame_from_arrays(a);
+    mcr::Frame frame = frame_from_arrays(a);
     const mcr::ExecOptions eo = exec_options(threads_, roi);
     mcr::Image out, alpha;
-    const mcr::Pass* given = frame.find(Role::Alpha);
+    const bool given = frame.has(Role::Alpha);
     {
       py::gil_scoped_release release;
       out = session_.reconstruction().run(frame, eo, nullptr, given ? &alpha : nullptr);
     }
     if (!given) return to_numpy(std::move(out));
     // With an alpha given: R, G, B and the filtered alpha (the given one where it is kept).
-    const mcr::Image& cover = alpha.empty() ? given->image : alpha;
-    mcr::Image rgba(out.width(), out.height(), 4);
-    const std::size_t ac = std::size_t(cover.channels());
-    for (std::size_t i = 0, n = rgba.pixel_count(); i < n; ++i) {
-      for (std::size_t c = 0; c < 3; ++c) rgba.data()[i * 4 + c] = out.data()[i * 3 + c];
-      rgba.data()[i * 4 + 3] = cover.data()[i * ac];
-    }
-    return to_numpy(std::move(rgba));
+    mcr::put_alpha(frame, std::move(alpha));
+    return to_numpy(mcr::rgba_result(out, frame));
   }
 
   py::dict denoise_file(const std::string& input, const std::string& output, const std::optional<std::string>& layer,

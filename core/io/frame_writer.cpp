@@ -89,6 +89,17 @@ void check_write(const std::string& path, const WriteOptions& options) {
   check_display_transform(options.display);
 }
 
+Image rgba_result(const Image& rgb, const Frame& input) {
+  Image out(rgb.width(), rgb.height(), 4, 1.0f);
+  const Pass* a = input.find(Role::Alpha);
+  const std::size_t rc = std::size_t(rgb.channels()), ac = a ? std::size_t(a->image.channels()) : 0;
+  for (std::size_t i = 0, n = out.pixel_count(); i < n; ++i) {
+    for (std::size_t c = 0; c < 3; ++c) out.data()[i * 4 + c] = rgb.data()[i * rc + c];
+    if (a) out.data()[i * 4 + 3] = a->image.data()[i * ac];
+  }
+  return out;
+}
+
 void write_result(const std::string& path, const Image& rgb, const Frame& input, const WriteOptions& options) {
   if (rgb.width() != input.width || rgb.height() != input.height || rgb.channels() < 3)
     throw Error(Errc::Internal, "write_result: result does not match the frame");

@@ -30,6 +30,10 @@ struct WriteOptions {
 // EXR compression must be one OpenImageIO writes; the display transform must exist.
 void check_write(const std::string& path, const WriteOptions& options);
 
+// R,G,B from rgb and A from the input's alpha pass (1 when absent): the pixels write_result
+// writes first, interleaved (4 channels), for a front end that hands them over in memory.
+Image rgba_result(const Image& rgb, const Frame& input);
+
 // R,G,B from rgb, A from the input's alpha pass (1 when absent), via temp + rename, in the
 // format the extension names (check_write first). JPEG has no alpha: R,G,B only.
 void write_result(const std::string& path, const Image& rgb, const Frame& input, const WriteOptions& options = {});

@@ -37,6 +37,10 @@ std::string alpha_kept_because(const ParamSet& params, const Frame& frame) {
   return "alpha " + rounded_text(first, 4) + " everywhere";
 }
 
+std::string alpha_kept_note(const Frame& frame, const std::string& why) {
+  return frame.has(Role::Alpha) ? "alpha: kept as it is (" + why + ")" : std::string();
+}
+
 namespace {
 
 // The light passes: only components=light_passes reads them (the alpha's run is the beauty's).

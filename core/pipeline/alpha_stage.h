@@ -32,6 +32,8 @@ std::unique_ptr<Filter> make_alpha_filter(const Filter& colour_filter);
 // Why `frame`'s alpha is not filtered, or "" when it is: no alpha pass, an alpha equal
 // everywhere (its value named), holes=alpha (the alpha marks the sampled pixels, not coverage).
 std::string alpha_kept_because(const ParamSet& params, const Frame& frame);
+// "alpha: kept as it is (<why>)" for a frame with an alpha pass, "" without one (nothing to say).
+std::string alpha_kept_note(const Frame& frame, const std::string& why);
 
 // The frame the alpha's filter runs on: the colour pass replaced by the alpha in R, G and B, and
 // every feature pass, but not the alpha (the filter would keep its 0s), the variance (the

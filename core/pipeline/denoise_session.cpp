@@ -185,7 +185,7 @@ void DenoiseSession::filter_alpha_in_bands(Filter& alpha_filter, FileBands& sour
                                            double max_bytes, Frame& frame, std::vector<std::string>& notes) {
   const std::string why = alpha_kept_because(reconstruction_.filter().params(), frame);
   if (!why.empty()) {
-    if (frame.has(Role::Alpha)) notes.push_back("alpha: kept as it is (" + why + ")");
+    if (std::string n = alpha_kept_note(frame, why); !n.empty()) notes.push_back(std::move(n));
     return;
   }
   TiledOptions o = colour;

@@ -118,7 +118,7 @@ Image Reconstruction::run_alpha(const Frame& frame, const ExecOptions& options) 
   if (!alpha_) return {};
   const std::string why = alpha_kept_because(filter().params(), frame);
   if (!why.empty()) {
-    if (frame.has(Role::Alpha)) notes_.push_back("alpha: kept as it is (" + why + ")");
+    if (std::string n = alpha_kept_note(frame, why); !n.empty()) notes_.push_back(std::move(n));
     alpha_->accumulator.reset();  // its history would skip this frame
     if (alpha_->filter) alpha_->filter->reset();
     return {};
