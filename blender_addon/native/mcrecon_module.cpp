@@ -237,6 +237,7 @@ struct ArrayPasses {
   py::object colour, albedo, normal, position, depth, motion, variance, sample_count, alpha;
   std::string normal_space;
   py::object diffuse_colour = py::none(), glossy_colour = py::none();  // Blender's DiffCol / GlossCol (mirrors)
+  py::object geometry_normal = py::none();  // Blender's world-space Normal beside a camera-space Denoising Normal
 };
 
 mcr::Space space_from(const std::string& s, const char* what) {
@@ -253,6 +254,11 @@ mcr::Frame frame_from_arrays(const ArrayPasses& a) {
   add_array(f, Role::Colour, a.colour, mcr::Space::None);
   add_array(f, Role::Albedo, a.albedo, mcr::Space::None);
   add_array(f, Role::Normal, a.normal, space_from(a.normal_space, "normal_space"));
+  if (!a.geometry_normal.is_none()) {  // as a Blender file's two normals: geometry reads this one (world space)
+    add_array(f, Role::Normal, a.geometry_normal, mcr::Space::World);
+    f.passes.back().name = "geometry_normal";
+    f.passes.back().priority = -1;  // features read `normal`
+  }
   add_array(f, Role::Position, a.position, mcr::Space::World);
   add_array(f, Role::Depth, a.depth, mcr::Space::Camera);
   add_array(f, Role::Motion, a.motion, mcr::Space::None);
@@ -518,19 +524,22 @@ PYBIND11_MODULE(mcrecon, m) {
           "denoise",
           [](Session& s, py::object colour, py::object albedo, py::object normal, py::object position, py::object depth,
              py::object motion, py::object variance, py::object sample_count, py::object alpha,
-             const std::string& normal_space, const py::object& roi, py::object diffuse_colour, py::object glossy_colour) {
+             const std::string& normal_space, const py::object& roi, py::object diffuse_colour, py::object glossy_colour,
+             py::object geometry_normal) {
             return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space,
-                              diffuse_colour, glossy_colour},
+                              diffuse_colour, glossy_colour, geometry_normal},
                              roi);
           },
           py::arg("colour"), py::arg("albedo") = py::none(), py::arg("normal") = py::none(),
           py::arg("position") = py::none(), py::arg("depth") = py::none(), py::arg("motion") = py::none(),
           py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
           py::arg("normal_space") = "world", py::arg("roi") = py::none(), py::arg("diffuse_colour") = py::none(),
-          py::arg("glossy_colour") = py::none(),
+          py::arg("glossy_colour") = py::none(), py::arg("geometry_normal") = py::none(),
           "Filters one frame given as float32 H x W x C arrays; returns H x W x 3 float32, H x W x 4 with alpha "
           "given (the alpha filtered as params alpha= says, else as given). diffuse_colour / "
-          "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them).")
+          "glossy_colour: Blender's Diffuse / Glossy Color passes (bmfr and accumulate tell mirrors by them). "
+          "geometry_normal: Blender's world-space Normal pass beside a camera-space normal (its Denoising Normal, "
+          "normal_space='camera'), as a file holds both: the alpha's partly covered pixels are read from it.")
       .def("denoise_file", &Session::denoise_file, py::arg("input"), py::arg("output"), py::arg("layer") = py::none(),
            py::arg("passes") = py::dict(), py::arg("keep_passes") = false, py::arg("keep_components") = false,
            py::arg("display") = py::none(), py::arg("max_memory_mb") = 0, py::arg("half") = py::none(),
@@ -549,10 +558,10 @@ PYBIND11_MODULE(mcrecon, m) {
       [](const std::string& filter, py::object colour, py::object albedo, py::object normal, py::object position,
          py::object depth, py::object motion, py::object variance, py::object sample_count, py::object alpha,
          const std::string& normal_space, const py::dict& params, int threads, const py::object& roi,
-         const py::object& accumulate, py::object diffuse_colour, py::object glossy_colour) {
+         const py::object& accumulate, py::object diffuse_colour, py::object glossy_colour, py::object geometry_normal) {
         Session s(filter, params, threads, accumulate);
         return s.denoise({colour, albedo, normal, position, depth, motion, variance, sample_count, alpha, normal_space,
-                          diffuse_colour, glossy_colour},
+                          diffuse_colour, glossy_colour, geometry_normal},
                          roi);
       },
       py::arg("filter"), py::arg("colour"), py::arg("albedo") = py::none(), py::arg("normal") = py::none(),
@@ -560,9 +569,10 @@ PYBIND11_MODULE(mcrecon, m) {
       py::arg("variance") = py::none(), py::arg("sample_count") = py::none(), py::arg("alpha") = py::none(),
       py::arg("normal_space") = "world", py::arg("params") = py::dict(), py::arg("threads") = 0,
       py::arg("roi") = py::none(), py::arg("accumulate") = false, py::arg("diffuse_colour") = py::none(),
-      py::arg("glossy_colour") = py::none(),
+      py::arg("glossy_colour") = py::none(), py::arg("geometry_normal") = py::none(),
       "Filters one frame given as float32 H x W x C numpy arrays (colour RGB or RGBA, features as available; "
-      "diffuse_colour / glossy_colour: Blender's Diffuse / Glossy Color, by which bmfr and accumulate tell mirrors); "
+      "diffuse_colour / glossy_colour: Blender's Diffuse / Glossy Color, by which bmfr and accumulate tell mirrors; "
+      "geometry_normal: Blender's world-space Normal beside a camera-space normal, normal_space='camera'); "
       "returns H x W x 3 float32, H x W x 4 with alpha given (the alpha filtered as params alpha= says, else as "
       "given).");
 

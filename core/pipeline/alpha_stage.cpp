@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "pipeline/filter_catalog.h"
 #include "util/parallel.h"
@@ -87,23 +88,46 @@ AlphaRange alpha_range(const Image& alpha) {
   return r;
 }
 
-Image finish_alpha(const Image& filtered, AlphaRange range, int nthreads) {
-  const int w = filtered.width(), h = filtered.height(), ch = filtered.channels();
+void PartialCoverage::mark(const Frame& rows, int y0) {
+  const Pass* normal = rows.find(Role::Normal, Prefer::Geometry);
+  if (!normal || normal->image.channels() < 3) return;
+  const Image& n = normal->image;
+  for (int y = 0; y < n.height(); ++y)
+    for (int x = 0; x < n.width(); ++x) {
+      const float* v = n.pixel(x, y);
+      const float len2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];  // NaN: not partial (filtered)
+      mask_[std::size_t(y0 + y) * std::size_t(width_) + std::size_t(x)] =
+          len2 > 0.0f && len2 < kCoveredNormal * kCoveredNormal;
+    }
+}
+
+Image finish_alpha(const Image& filtered, const Image& own, const PartialCoverage& coverage, AlphaRange range,
+                   int nthreads, std::size_t* kept) {
+  const int w = filtered.width(), h = filtered.height(), ch = filtered.channels(), och = own.channels();
   Image out(w, h, 1);
+  std::vector<std::size_t> row_kept(std::size_t(h), 0);
   parallel_rows(0, h, nthreads, [&](int y) {
     const float* in = filtered.pixel(0, y);
+    const float* mine = own.pixel(0, y);
     float* o = out.pixel(0, y);
     for (int x = 0; x < w; ++x) {
-      const float v = in[x * ch];
-      o[x] = std::isfinite(v) ? std::clamp(v, range.lo, range.hi) : range.lo;
+      const float v = in[x * ch], a = mine[x * och];
+      if (coverage.partial(x, y) && std::isfinite(a)) {
+        o[x] = a;
+        ++row_kept[std::size_t(y)];
+      } else {
+        o[x] = std::isfinite(v) ? std::clamp(v, range.lo, range.hi) : range.lo;
+      }
     }
   });
+  if (kept) *kept = std::accumulate(row_kept.begin(), row_kept.end(), std::size_t(0));
   return out;
 }
 
-std::string alpha_note(const Filter& alpha_filter, AlphaRange range) {
+std::string alpha_note(const Filter& alpha_filter, AlphaRange range, std::size_t kept) {
   return "alpha: filtered by " + alpha_filter.info().name + " as a grey colour (demodulation off), clamped to [" +
-         rounded_text(range.lo, 4) + ", " + rounded_text(range.hi, 4) + "]";
+         rounded_text(range.lo, 4) + ", " + rounded_text(range.hi, 4) + "], its own at " + std::to_string(kept) +
+         " partly covered pixels (normal pass shorter than " + rounded_text(kCoveredNormal, 4) + ")";
 }
 
 void put_alpha(Frame& frame, Image alpha) {

@@ -197,9 +197,11 @@ void DenoiseSession::filter_alpha_in_bands(Filter& alpha_filter, FileBands& sour
   AlphaRows rows(source);
   std::vector<std::string> said;
   const AlphaRange range = alpha_range(frame.image(Role::Alpha));
-  Image alpha = finish_alpha(run_tiled(alpha_filter, rows, o, &said), range, o.nthreads);
+  const Image filtered = run_tiled(alpha_filter, rows, o, &said);
+  std::size_t kept = 0;
+  Image alpha = finish_alpha(filtered, frame.image(Role::Alpha), rows.coverage(), range, o.nthreads, &kept);
   put_alpha(frame, std::move(alpha));
-  notes.push_back(alpha_note(alpha_filter, range));
+  notes.push_back(alpha_note(alpha_filter, range, kept));
   for (const std::string& n : said) notes.push_back("alpha: " + n);
 }
 

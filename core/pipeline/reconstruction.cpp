@@ -126,10 +126,15 @@ Image Reconstruction::run_alpha(const Frame& frame, const ExecOptions& options) 
   alpha_filter();
   Frame grey = alpha_frame(frame);
   const AlphaRange range = alpha_range(frame.image(Role::Alpha));
+  PartialCoverage coverage(frame.width, frame.height);
+  coverage.mark(frame, 0);
   const std::size_t before = notes_.size();
-  Image alpha = finish_alpha(run_stage(*alpha_, grey, options), range, options.nthreads);
+  const Image filtered = run_stage(*alpha_, grey, options);
+  // grey's colour now holds the alpha the filter read: the frame's, or its accumulation.
+  std::size_t kept = 0;
+  Image alpha = finish_alpha(filtered, grey.image(Role::Colour), coverage, range, options.nthreads, &kept);
   for (std::size_t k = before; k < notes_.size(); ++k) notes_[k] = "alpha: " + notes_[k];
-  notes_.push_back(alpha_note(*alpha_->filter, range));
+  notes_.push_back(alpha_note(*alpha_->filter, range, kept));
   for (const std::string& m : alpha_->filter->notes()) notes_.push_back("alpha: " + m);
   return alpha;
 }

@@ -107,7 +107,8 @@ def test_alpha_is_filtered_as_the_cli_does(tmp):
     L = "ViewLayer"
     passes = dict(colour=group(names, px, L + ".Combined", "RGB"), alpha=group(names, px, L + ".Combined", "A"),
                   albedo=group(names, px, L + ".Denoising Albedo", "RGB"),
-                  normal=group(names, px, L + ".Denoising Normal", "XYZ"),
+                  normal=group(names, px, L + ".Denoising Normal", "XYZ"), normal_space="camera",
+                  geometry_normal=group(names, px, L + ".Normal", "XYZ"),
                   position=group(names, px, L + ".Position", "XYZ"), depth=group(names, px, L + ".Depth", "Z"))
     out = os.path.join(tmp, "alpha_cli.exr")
     cli("denoise", PRODUCT, "-o", out, "-f", "pwaf")
