@@ -147,8 +147,9 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   roles.insert(roles.end(), needs.optional.begin(), needs.optional.end());
   roles.push_back(Role::Alpha);  // the output's
   Filter* alpha_filter = reconstruction_.alpha_filter();
-  if (alpha_filter) {  // what the alpha's own run reads besides
-    const PassNeeds an = alpha_filter->needs();
+  if (alpha_filter) {  // what the alpha's own run reads besides, and the normal its partly covered pixels
+    PassNeeds an = alpha_filter->needs();
+    an.optional.push_back(Role::Normal);
     for (const auto* list : {&an.required, &an.optional})
       for (Role r : *list)
         if (std::find(roles.begin(), roles.end(), r) == roles.end()) roles.push_back(r);
