@@ -7,6 +7,7 @@
 #include "kernels/foveation.h"
 #include "kernels/noise_scale.h"
 #include "prepare/empty_pixels.h"
+#include "prepare/first_hit.h"
 #include "prepare/step_back.h"
 #include "util/error.h"
 #include "util/isa.h"
@@ -102,10 +103,23 @@ PassNeeds Filter::needs() const {
   PassNeeds n = own_needs();
   std::vector<Role> req, opt;
   std::vector<std::string> why;
-  preparation_needs(params_, info_.steps, req, why, opt);
+  preparation_needs(params_, prep_steps(), req, why, opt);
   for (std::size_t i = 0; i < req.size(); ++i) n.require(req[i], why[i]);
   for (Role r : opt) n.use(r);
   return n;
+}
+
+PrepSteps Filter::prep_steps() const {
+  PrepSteps s = info_.steps;
+  if (s.holes) {  // the first-hit holes of position and depth, for a filter that reads them
+    const PassNeeds own = own_needs();
+    const auto reads = [&](Role r) {
+      return std::find(own.required.begin(), own.required.end(), r) != own.required.end() ||
+             std::find(own.optional.begin(), own.optional.end(), r) != own.optional.end();
+    };
+    s.first_hit = reads(Role::Position) || reads(Role::Depth);
+  }
+  return s;
 }
 
 std::vector<Role> Filter::missing_passes(const Frame& frame) const {
@@ -149,6 +163,7 @@ int Filter::band_margin() const {
 int Filter::band_halo() const {
   if (!why_not_tileable().empty()) return -1;
   int prep = 1;  // the firefly clamp's keep mask reads the 8 neighbours
+  if (prep_steps().first_hit) prep += kFirstHitRadius;
   if (info_.steps.outliers && params_.get_float("firefly_k") > 0) prep += int(params_.get_int("firefly_radius"));
   if (info_.steps.albedo_prefilter && params_.get_float("albedo_prefilter") > 0) prep += 16;
   return band_margin() + own_reach() + prep + kNoiseEstimateReach;
@@ -178,7 +193,7 @@ void Filter::measure(const Frame& band, const Roi& rows, int nthreads) {
     exposure_level_.add(band.image(Role::Colour), r, nthreads);
     return;
   }
-  prepare(band, params_, info_.steps, reads(r, band.width, band.height), nthreads, prepared_, exposure_);
+  prepare(band, params_, prep_steps(), reads(r, band.width, band.height), nthreads, prepared_, exposure_);
   if (stats_pass_ == 0) {  // the first pass: the holes and every pass's spread
     measured_holes_ += prepared_.holes;
     for (const Pass& p : prepared_.frame->passes) {
@@ -309,7 +324,7 @@ Image Filter::execute(const Frame& frame, const ExecOptions& options) {
   }
 
   const double exposure = exposure_for(input, nthreads);
-  prepare(frame, params_, info_.steps, reads(roi, w, h), nthreads, prepared_, exposure);
+  prepare(frame, params_, prep_steps(), reads(roi, w, h), nthreads, prepared_, exposure);
   if (exposure != 1.0) {
     const char* whose = exposure_pin_ == ExposurePin::History ? ", the first frame's"
                         : exposure_pin_ == ExposurePin::Statistics ? ", the whole frame's" : "";

@@ -94,6 +94,9 @@ class Filter {
 
   // What the current settings read: the filter's own needs plus its preparation steps'.
   PassNeeds needs() const;
+  // The preparation steps this run takes: info().steps, with the first-hit holes where the
+  // filter reads position or depth (prepare/first_hit.h).
+  PrepSteps prep_steps() const;
   // Passes in needs().required that the frame lacks.
   std::vector<Role> missing_passes(const Frame& frame) const;
   // Settings given that change nothing under the others (from commit()), e.g.

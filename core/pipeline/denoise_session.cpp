@@ -146,6 +146,9 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   std::vector<Role> roles = needs.required;
   roles.insert(roles.end(), needs.optional.begin(), needs.optional.end());
   roles.push_back(Role::Alpha);  // the output's
+  if (filter.prep_steps().first_hit)  // what tells its first-hit holes (prepare/first_hit.h)
+    for (Role r : {Role::Depth, Role::Normal})
+      if (std::find(roles.begin(), roles.end(), r) == roles.end()) roles.push_back(r);
   Filter* alpha_filter = reconstruction_.alpha_filter();
   if (alpha_filter) {  // what the alpha's own run reads besides, and the normal its partly covered pixels
     PassNeeds an = alpha_filter->needs();

@@ -8,6 +8,7 @@
 #include "prepare/demodulation.h"
 #include "prepare/exposure.h"
 #include "prepare/outliers.h"
+#include "prepare/first_hit.h"
 #include "prepare/pull_push.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -225,6 +226,17 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
         if (p.role != Role::SampleCount && p.role != Role::Alpha) pull_push_fill(p.image, holes, nthreads);
       out.holes = std::size_t(std::count(holes.begin(), holes.end(), 0.0f));
       out.notes.push_back("filled " + std::to_string(out.holes) + " unsampled pixels by pull-push");
+    }
+  }
+  out.first_hit = 0;
+  if (steps.holes && steps.first_hit) {
+    // The fill reads kFirstHitRadius pixels around the region the filter reads (Filter::band_halo).
+    const std::vector<unsigned char> holes = first_hit_holes(*out.frame, work, nthreads);
+    if (!holes.empty()) {
+      out.first_hit = fill_first_hit_holes(own_frame(frame, out), holes, work, nthreads);
+      out.notes.push_back("position and depth: " + std::to_string(out.first_hit) +
+                          " pixels whose first sample met no surface though others did (a volume, an edge) take "
+                          "their neighbours'");
     }
   }
   // Albedo prefilter: every later use of the albedo pass sees the smoothed one.

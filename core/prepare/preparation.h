@@ -4,7 +4,8 @@
 //                    scaled back after the step back (prepare/exposure.h): exposure
 //   holes            pull-push fill of the unsampled pixels, every pass (thesis 5.1):
 //                    holes = auto (sample_count == 0 where that pass exists) | none |
-//                    sample_count | alpha (alpha == 0)
+//                    sample_count | alpha (alpha == 0); then, for a filter that reads position
+//                    or depth, the first-hit holes of those passes (prepare/first_hit.h)
 //   albedo_prefilter the albedo pass smoothed before any use (prepare/albedo_prefilter.h):
 //                    albedo_prefilter (range sigma, 0 = off), albedo_prefilter_position
 //   demodulate       colour / albedo (prepare/demodulation.h), multiplied back after run():
@@ -30,7 +31,9 @@ namespace mcr {
 
 struct PrepSteps {
   bool holes = true, albedo_prefilter = true, demodulate = true, outliers = true, step_back = true, exposure = true;
-  static PrepSteps none() { return {false, false, false, false, false, false}; }
+  // The first-hit holes (with holes): set by the filter for a run that reads position or depth.
+  bool first_hit = false;
+  static PrepSteps none() { return {false, false, false, false, false, false, false}; }
 };
 
 // `own` followed by the parameters of the steps, then `components`.
@@ -84,6 +87,7 @@ struct Prepared {
   std::vector<std::string> notes;
   Frame own;                     // storage when a step changed a pass
   std::size_t holes = 0;         // unsampled pixels filled
+  std::size_t first_hit = 0;     // first-hit holes filled (prepare/first_hit.h)
 };
 
 // Runs the steps over `work` (clipped to the frame). Throws MissingPass naming the frame's
