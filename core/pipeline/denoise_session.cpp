@@ -143,19 +143,22 @@ StageTimes DenoiseSession::run_in_bands(const std::string& input, const std::str
   StageTimes t;
   const auto t0 = std::chrono::steady_clock::now();
   PassNeeds needs = filter.needs();
-  std::vector<Role> roles = needs.required;
-  roles.insert(roles.end(), needs.optional.begin(), needs.optional.end());
-  roles.push_back(Role::Alpha);  // the output's
-  if (filter.prep_steps().first_hit)  // what tells its first-hit holes (prepare/first_hit.h)
-    for (Role r : {Role::Depth, Role::Normal})
+  std::vector<Role> roles;
+  const auto keep = [&roles](const std::vector<Role>& more) {
+    for (Role r : more)
       if (std::find(roles.begin(), roles.end(), r) == roles.end()) roles.push_back(r);
+  };
+  keep(needs.required);
+  keep(needs.optional);
+  keep({Role::Alpha});  // the output's
+  // Read where present but not asked for: what tells the first-hit holes (prepare/first_hit.h).
+  if (filter.prep_steps().first_hit) keep({Role::Depth, Role::Normal});
   Filter* alpha_filter = reconstruction_.alpha_filter();
   if (alpha_filter) {  // what the alpha's own run reads besides, and the normal its partly covered pixels
-    PassNeeds an = alpha_filter->needs();
-    an.optional.push_back(Role::Normal);
-    for (const auto* list : {&an.required, &an.optional})
-      for (Role r : *list)
-        if (std::find(roles.begin(), roles.end(), r) == roles.end()) roles.push_back(r);
+    const PassNeeds an = alpha_filter->needs();
+    keep(an.required);
+    keep(an.optional);
+    keep({Role::Normal});
   }
   FileBands source(input, read, roles);
   check_passes(needs, source.layout(), "filter '" + filter.info().name + "'");

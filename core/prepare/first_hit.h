@@ -21,14 +21,20 @@ namespace mcr {
 inline constexpr int kFirstHitRadius = 4;
 inline constexpr float kNoSurfaceDepth = 1e9f;  // Blender writes 1e10 where a ray met nothing
 
-// The pixels of `work` (clipped to the frame) that are first-hit holes, as a mask over the
-// frame (empty when there are none, or no depth or normal pass to tell them by: they are read
-// where the frame has them, not asked for; a run in bands reads them for it).
-std::vector<unsigned char> first_hit_holes(const Frame& frame, const Roi& work, int nthreads);
+// What each pixel's first sample met, over `work` (clipped to the frame) grown by
+// kFirstHitRadius (the pixels a fill reads); kMissed elsewhere. A hole lies inside `work`.
+enum : unsigned char { kFirstHitMet = 0, kFirstHitHole = 1, kFirstHitMissed = 2 };
+struct FirstHitMap {
+  std::vector<unsigned char> state;  // width x height, row-major; empty when there is no hole
+  std::size_t holes = 0;
+};
+// Empty when there is no hole, or no depth or normal pass to tell them by (they are read where
+// the frame has them, not asked for; a run in bands reads them for it).
+FirstHitMap first_hit_map(const Frame& frame, const Roi& work, int nthreads);
 
-// Fills frame's position and depth passes at the holes (reading up to kFirstHitRadius pixels
-// around them, inside the frame). Returns the number of holes filled.
-std::size_t fill_first_hit_holes(Frame& frame, const std::vector<unsigned char>& holes, const Roi& work,
-                                 int nthreads);
+// Fills frame's position passes, and its depth passes where they say no surface, at the map's
+// holes. Returns the number of holes filled (a hole with no pixel that met a surface within
+// kFirstHitRadius stays as it is).
+std::size_t fill_first_hit_holes(Frame& frame, const FirstHitMap& map, int nthreads);
 
 }  // namespace mcr

@@ -7,8 +7,8 @@
 #include "prepare/albedo_prefilter.h"
 #include "prepare/demodulation.h"
 #include "prepare/exposure.h"
-#include "prepare/outliers.h"
 #include "prepare/first_hit.h"
+#include "prepare/outliers.h"
 #include "prepare/pull_push.h"
 #include "util/error.h"
 #include "util/parallel.h"
@@ -228,13 +228,12 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
       out.notes.push_back("filled " + std::to_string(out.holes) + " unsampled pixels by pull-push");
     }
   }
-  out.first_hit = 0;
   if (steps.holes && steps.first_hit) {
     // The fill reads kFirstHitRadius pixels around the region the filter reads (Filter::band_halo).
-    const std::vector<unsigned char> holes = first_hit_holes(*out.frame, work, nthreads);
-    if (!holes.empty()) {
-      out.first_hit = fill_first_hit_holes(own_frame(frame, out), holes, work, nthreads);
-      out.notes.push_back("position and depth: " + std::to_string(out.first_hit) +
+    const FirstHitMap map = first_hit_map(*out.frame, work, nthreads);
+    if (map.holes) {
+      const std::size_t filled = fill_first_hit_holes(own_frame(frame, out), map, nthreads);
+      out.notes.push_back("position and depth: " + std::to_string(filled) +
                           " pixels whose first sample met no surface though others did (a volume, an edge) take "
                           "their neighbours'");
     }

@@ -87,7 +87,6 @@ struct Prepared {
   std::vector<std::string> notes;
   Frame own;                     // storage when a step changed a pass
   std::size_t holes = 0;         // unsampled pixels filled
-  std::size_t first_hit = 0;     // first-hit holes filled (prepare/first_hit.h)
 };
 
 // Runs the steps over `work` (clipped to the frame). Throws MissingPass naming the frame's

@@ -62,9 +62,9 @@ TEST(FirstHit, HolesTakeTheMeanOfTheNearestRingThatMetASurface) {
   depth.at(8, 8, 0) = testutil::kNaN;
   const Frame before = f;
 
-  const std::vector<unsigned char> holes = first_hit_holes(f, Roi::all(9, 9), 2);
-  ASSERT_EQ(holes.size(), 81u);
-  EXPECT_EQ(fill_first_hit_holes(f, holes, Roi::all(9, 9), 2), 8u + 4u);
+  const FirstHitMap map = first_hit_map(f, Roi::all(9, 9), 2);
+  ASSERT_EQ(map.state.size(), 81u);
+  EXPECT_EQ(fill_first_hit_holes(f, map, 2), 8u + 4u);
   EXPECT_FLOAT_EQ(pos.at(4, 4, 0), 0.5f);  // (5, 3)'s
   EXPECT_FLOAT_EQ(pos.at(4, 4, 1), 0.3f);
   EXPECT_FLOAT_EQ(depth.at(4, 4, 0), 5.0f);
@@ -79,7 +79,7 @@ TEST(FirstHit, HolesTakeTheMeanOfTheNearestRingThatMetASurface) {
   EXPECT_EQ(f.passes[3].image.storage(), before.passes[3].image.storage());
   for (int y = 0; y < 9; ++y)
     for (int x = 0; x < 9; ++x)
-      if (!holes[std::size_t(y) * 9 + std::size_t(x)])
+      if (map.state[std::size_t(y) * 9 + std::size_t(x)] != kFirstHitHole)
         for (int c = 0; c < 3; ++c) ASSERT_EQ(pos.at(x, y, c), before.image(Role::Position).at(x, y, c));
 }
 
