@@ -81,16 +81,20 @@ SCENES = {
                         "Transparent, no table or wall): the fur's fringe of sub-pixel hair, the "
                         "back-lit leaves' edges and the flame are partial coverage against alpha "
                         "0; held out: never used to choose settings."),
+    "jewel": ("still", "Polished silver, a gold ring, chrome bearing balls, a cut-glass prism and a "
+                       "brushed spoon under a sun on a transparent background with a shadow "
+                       "catcher: at 64 spp the sun's sub-pixel mirror images are most of the "
+                       "error; a tune scene of that class."),
 }
 ORDER = ["room", "glossy", "dof", "anim", "sunlit", "showroom", "wall", "metal", "chrome", "orbit", "fog", "fence",
          "night", "studio",
-         "product", "cutout"]
+         "product", "cutout", "jewel"]
 # Parameters are chosen on the "tune" scenes and reported on the "report" scenes.
 SPLIT = {"room": "tune", "glossy": "tune", "dof": "report", "anim": "report",
          "sunlit": "report", "showroom": "report", "wall": "report", "metal": "report",
          "chrome": "report", "orbit": "report", "fog": "report", "fence": "report",
          "night": "report", "studio": "report", "product": "report",
-         "cutout": "report"}
+         "cutout": "report", "jewel": "tune"}
 # Noisy levels also rendered as two half buffers (same seed, sample offsets 0 and spp/2).
 HALVES = {"sunlit": [16], "showroom": [16], "wall": [16], "fog": [16], "fence": [16], "night": [16], "studio": [16],
           "cutout": [16]}
