@@ -46,6 +46,13 @@ struct AutoCheck {
   double input = 0;         // the input's there
 };
 
+// A kept input's firefly clamp (kept_firefly_k): the firefly step's rule at a k four times its 8,
+// the smallest power of two that left the tune scenes' references (room, glossy, jewel) as they
+// are (16 cut one pixel of jewel's), over the step's 7x7 window.
+constexpr double kKeptFireflyK = 32.0;
+constexpr int kKeptFireflyRadius = 3;
+constexpr double kKeptFireflyFloor = 0.1;  // a clamp smaller than this (x the exposure step) is undone
+
 class AutoFilter : public Filter {
  public:
   AutoFilter() : Filter(static_info()) {}
@@ -61,6 +68,7 @@ class AutoFilter : public Filter {
   void run(const Frame& frame, const Image& colour, const Roi& roi, Image& out, int nthreads) override;
 
  private:
+  void clamp_kept_fireflies(const Frame& frame, const Roi& roi, int nthreads, Image& out);
   std::vector<AutoScore> scores_;
   std::string chosen_;
   AutoCheck check_;
