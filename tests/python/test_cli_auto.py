@@ -69,7 +69,7 @@ class AutoCliTest(unittest.TestCase):
         self.assertEqual(auto["required_passes"], ["colour"])
         self.assertFalse(auto["temporal"])
         params = {p["name"]: p for p in auto["parameters"]}
-        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "exposure", "components", "alpha"})
+        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "kept_firefly_k", "exposure", "components", "alpha"})
         self.assertEqual(params.pop("components")["choices"], ["beauty", "light_passes"])  # every filter's
         self.assertEqual(params.pop("exposure")["choices"], ["auto", "off"])  # every image filter's
         self.assertEqual(params.pop("alpha")["choices"], ["filter", "keep"])  # every flat-frame filter's
