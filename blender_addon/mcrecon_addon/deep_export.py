@@ -19,7 +19,8 @@ import tempfile
 
 import bpy
 
-from . import native
+from . import native, render_hooks
+from .settings_undo import Undo
 
 AOV = "mcrecon_z"
 NODE_CAMERA = "mcrecon depth (Camera Data)"
@@ -46,35 +47,6 @@ def camera_attributes(scene):
         sensor_w = cam.sensor_width
     return {"mcrecon:lens_mm": float(cam.lens), "mcrecon:fstop": float(cam.dof.aperture_fstop),
             "mcrecon:focus_distance": float(focus), "mcrecon:sensor_width_mm": float(sensor_w)}
-
-
-class _Undo:
-    """Settings set through it are put back in reverse order by restore()."""
-
-    def __init__(self):
-        self.steps = []
-
-    def set(self, owner, attr, value):
-        old = getattr(owner, attr)
-        if old != value:
-            self.steps.append(lambda: setattr(owner, attr, old))
-            setattr(owner, attr, value)
-
-    def keep(self, owner, attr):
-        """Puts back the current value, whatever is set later."""
-        old = getattr(owner, attr)
-        self.steps.append(lambda: setattr(owner, attr, old))
-
-    def add(self, undo):
-        self.steps.append(undo)
-
-    def restore(self):
-        for step in reversed(self.steps):
-            try:
-                step()
-            except Exception as e:  # keep restoring the rest
-                print(f"mcrecon: export_deep: could not restore a setting: {e}", flush=True)
-        self.steps.clear()
 
 
 def _depth_aov(scene, layer, undo, log):
@@ -155,7 +127,8 @@ def export(scene, filepath, samples, progress=None, log=print):
         raise ValueError(f"'{filepath}': the per-sample file is an OpenEXR (.exr)")
     r, cy = scene.render, scene.cycles
     layer = bpy.context.view_layer if bpy.context.view_layer in scene.view_layers.values() else scene.view_layers[0]
-    undo = _Undo()
+    undo = Undo("export_deep")
+    undo.add(render_hooks.suspend())
     tmpdir = tempfile.mkdtemp(prefix="mcrecon_deep_", dir=bpy.app.tempdir or None)
     try:
         undo.set(r, "engine", "CYCLES")

@@ -227,6 +227,44 @@ class MCRECON_OT_export_deep(bpy.types.Operator):
         return {"FINISHED"}
 
 
+class MCRECON_OT_render_halves(bpy.types.Operator):
+    """Render the current frame as two half buffers (half the samples each, sample offsets 0 and N/2: the same samples as one render) and denoise them with the filter's variance pass from their difference"""
+    bl_idname = "mcrecon.render_halves"
+    bl_label = "Render Halves and Denoise"
+    bl_options = {"REGISTER"}
+
+    filepath: bpy.props.StringProperty(name="Output", subtype="FILE_PATH", default="//denoised_halves.exr",
+                                       description="The denoised image (EXR, or PNG / JPEG / TIFF through the scene's view)")
+    keep_halves: bpy.props.BoolProperty(name="Keep Halves", default=False,
+                                        description="Keep the two half buffers beside the output (_half0.exr, _half1.exr)")
+
+    def invoke(self, context, event):
+        context.window_manager.fileselect_add(self)
+        return {"RUNNING_MODAL"}
+
+    def execute(self, context):
+        from . import halves, render_hooks
+        mc = native.get()
+        wm = context.window_manager
+        wm.progress_begin(0, 3)
+        try:
+            info = halves.render_and_denoise(context.scene, self.filepath, keep_halves=self.keep_halves,
+                                             progress=lambda done, n: wm.progress_update(done),
+                                             log=lambda m: print("mcrecon: " + m, flush=True))
+        except (ValueError, RuntimeError, mc.Error) as e:
+            self.report({"ERROR"}, f"mcrecon: render_halves: {e}" + (f" [{e.kind}]" if isinstance(e, mc.Error) else ""))
+            return {"CANCELLED"}
+        finally:
+            wm.progress_end()
+        out = bpy.path.abspath(self.filepath)
+        render_hooks.show_result(out, now=True)
+        for note in info["notes"]:
+            print("mcrecon: " + note, flush=True)
+        self.report({"INFO"}, f"mcrecon: {out}: {info['samples']} samples as two halves of {info['half']}, "
+                              f"{status.filter_text(info['filter'], info['timings'])}")
+        return {"FINISHED"}
+
+
 class MCRECON_OT_restore_scene(bpy.types.Operator):
     """Put back every scene setting mcrecon changed (passes, Cycles denoising, compositing) and remove the nodes it added"""
     bl_idname = "mcrecon.restore_scene"
@@ -253,7 +291,7 @@ class MCRECON_OT_report(bpy.types.Operator):
         return {'FINISHED'}
 
 
-_classes = (MCRECON_OT_render, MCRECON_OT_export_deep, MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
+_classes = (MCRECON_OT_render, MCRECON_OT_export_deep, MCRECON_OT_render_halves, MCRECON_OT_denoise_files, MCRECON_OT_apply_passes, MCRECON_OT_restore_scene, MCRECON_OT_report)
 
 
 def register():

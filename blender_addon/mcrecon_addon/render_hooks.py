@@ -27,6 +27,20 @@ RESULT_IMAGE = "mcrecon Result"
 _job = {"session": None, "key": None, "next": None, "warned_before": False, "written": False}  # next: the frame that continues the history
 # Temp results: path -> {"packed": shown and packed, "released": no longer needed for the output}.
 _temps = {}
+_suspended = [0]  # > 0 while the add-on's own operators render (suspend())
+
+
+def suspend():
+    """The add-on's own sub-renders (the per-sample export, the half buffers) are not the user's
+    renders: no handler denoises or writes them. Returns the call that ends it."""
+    _suspended[0] += 1
+    done = []
+
+    def resume():
+        if not done:
+            done.append(True)
+            _suspended[0] -= 1
+    return resume
 
 
 def log(scene, text, error=False):
@@ -170,7 +184,7 @@ def _session(scene):
     return _job["session"]
 
 
-def _show_result(path, now=False):
+def show_result(path, now=False):
     """Loads `path` as the image "mcrecon Result", packed into the .blend with a fake user (kept
     when the file is saved), and shows it in image editors that show the render. now: the
     caller is in the main loop already."""
@@ -248,6 +262,8 @@ def denoise_render(scene, source, out, render_path):
 
 @persistent
 def on_render_init(scene, *args):
+    if _suspended[0]:
+        return
     if composite.state["running"]:
         return
     _job.update(session=None, key=None, next=None, warned_before=False, written=False)
@@ -257,6 +273,8 @@ def on_render_init(scene, *args):
 
 @persistent
 def on_render_post(scene, *args):
+    if _suspended[0]:
+        return
     if composite.state["running"]:
         return
     # Not MultiLayer output (or F12 without a file): denoise the add-on's own pass file into a
@@ -288,11 +306,13 @@ def on_render_post(scene, *args):
                          "layer": pass_output.view_layer(scene).name, "temps": [tmp, source]})
         return
     _temps[tmp] = {"packed": False, "released": False}
-    _show_result(tmp)
+    show_result(tmp)
 
 
 @persistent
 def on_render_write(scene, *args):
+    if _suspended[0]:
+        return
     if not getattr(scene, "mcrecon", None) or not scene.mcrecon.enabled:
         return
     if composite.state["running"]:
@@ -328,7 +348,7 @@ def on_render_write(scene, *args):
         return
     out = denoise_render(scene, path, output_for(scene, path), path)
     if out is not None:
-        _show_result(out)
+        show_result(out)
 
 
 def finish_composites(scene):
@@ -339,7 +359,7 @@ def finish_composites(scene):
         _temps[path] = {"packed": False, "released": True}
         return path
     return composite.finish(scene, log=lambda m, error=False: log(scene, m, error=error),
-                            show=lambda p: _show_result(p, now=True), shown_path=shown_path)
+                            show=lambda p: show_result(p, now=True), shown_path=shown_path)
 
 
 def _denoise_shown_render():
@@ -372,17 +392,21 @@ def _denoise_shown_render():
         return None
     _remove(source)
     _temps[tmp] = {"packed": False, "released": True}
-    _show_result(tmp)
+    show_result(tmp)
     return None
 
 
 @persistent
 def on_render_cancel(scene, *args):
+    if _suspended[0]:
+        return
     on_render_complete(scene, cancelled=True)
 
 
 @persistent
 def on_render_complete(scene, *args, cancelled=False):
+    if _suspended[0]:
+        return
     if composite.state["running"]:
         return
     f12_multilayer = (not cancelled and not bpy.app.background and not _job["written"]

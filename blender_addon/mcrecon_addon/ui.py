@@ -167,6 +167,7 @@ def draw_render_menu(self, context):
     op = layout.operator("mcrecon.render", text="Render Denoised Animation (mcrecon)", icon="RENDER_ANIMATION")
     op.animation = True
     layout.operator("mcrecon.denoise_files", text="Denoise EXR Files (mcrecon)", icon="FILE_IMAGE")
+    layout.operator("mcrecon.render_halves", text="Render Halves and Denoise (mcrecon)", icon="RENDER_STILL")
     layout.operator("mcrecon.export_deep", text="Export Per-Sample EXR (mcrecon)", icon="OUTLINER_DATA_POINTCLOUD")
 
 

@@ -518,6 +518,52 @@ def case_export_deep():
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(OUT, "shot.blend"))  # for the batch script
 
 
+def halves_state(scene):
+    """What render_halves changes and must put back."""
+    r, cy = scene.render, scene.cycles
+    return {"filepath": r.filepath, "format": r.image_settings.file_format, "depth": r.image_settings.color_depth,
+            "compositing": r.use_compositing, "samples": cy.samples, "offset": cy.sample_offset,
+            "adaptive": cy.use_adaptive_sampling, "denoising": cy.use_denoising,
+            "layers": [vl.use for vl in scene.view_layers]}
+
+
+def case_render_halves():
+    """Issue 14: the current frame as two half buffers, denoised with their variance; the oracle
+    renders the same samples as one render."""
+    scene = room_scene()
+    mc = scene.mcrecon
+    mc.enabled = True  # its render handlers must leave the halves alone
+    mc.filter = "box"
+    mc.last_message = ""
+    scene.cycles.seed = 7
+    scene.cycles.samples = 8
+    scene.cycles.use_adaptive_sampling = True  # turned off for the halves, then put back
+    scene.render.filepath = os.path.join(OUT, "user_output_")
+    result["before"] = halves_state(scene)
+    out = os.path.join(OUT, "halves.exr")
+    result["op"] = sorted(bpy.ops.mcrecon.render_halves(filepath=out, keep_halves=True))
+    result["after"] = halves_state(scene)
+    result["message"] = mc.last_message
+    result["temp_left"] = sorted(f for f in os.listdir(bpy.app.tempdir) if f.startswith("mcrecon"))
+    img = bpy.data.images.get("mcrecon Result")
+    result["result_image"] = img.filepath if img else None
+    # An odd sample count is refused by name, before anything renders.
+    scene.cycles.samples = 7
+    try:
+        result["odd"] = sorted(bpy.ops.mcrecon.render_halves(filepath=os.path.join(OUT, "odd.exr")))
+    except RuntimeError as e:
+        result["odd"] = str(e)
+    scene.cycles.samples = 8
+    result["odd_written"] = os.path.exists(os.path.join(OUT, "odd.exr"))
+    # The oracle: the 8-spp render with the same seed, adaptive sampling off, all passes.
+    mc.enabled = False
+    scene.cycles.use_adaptive_sampling = False
+    scene.render.image_settings.file_format = "OPEN_EXR_MULTILAYER"
+    scene.render.image_settings.color_depth = "32"
+    scene.render.filepath = os.path.join(OUT, "full8")
+    bpy.ops.render.render(write_still=True)
+
+
 def case_install_zip():
     scene = bpy.context.scene
     import mcrecon_addon.native as native
@@ -538,6 +584,7 @@ enable_addon()
  "errors": case_errors, "light_passes": case_light_passes,
  "composite": case_composite, "install_zip": case_install_zip, "hygiene": case_hygiene,
  "png_anim": case_png_anim, "denoise_files": case_denoise_files,
- "composite_before": case_composite_before, "export_deep": case_export_deep}[CASE]()
+ "composite_before": case_composite_before, "export_deep": case_export_deep,
+ "render_halves": case_render_halves}[CASE]()
 with open(os.path.join(OUT, "result.json"), "w") as f:
     json.dump(result, f, indent=1)

@@ -488,6 +488,35 @@ def check_export_deep():
           f"{zerr:.1e}, motion up to {moving.max():.2f} px on the moving ball; settings put back")
 
 
+def check_render_halves():
+    """Issue 14: bpy.ops.mcrecon.render_halves on the room at 64x48, 8 samples: the mean of its two
+    halves is the 8-spp render with the same seed, its result is `mcrecon denoise half0 --half
+    half1` bit for bit, the scene is put back (adaptive sampling included), no temp file is left,
+    the render handlers left the halves alone, an odd sample count is refused by name."""
+    r, log = run_blender()
+    assert r["op"] == ["FINISHED"], (r["op"], log[-3000:])
+    changed = {k: (r["before"][k], r["after"][k]) for k in r["before"] if r["before"][k] != r["after"][k]}
+    assert not changed, f"render_halves left settings changed: {changed}"
+    assert r["temp_left"] == [], r["temp_left"]
+    assert r["message"] == "", f"a render handler ran on a half: {r['message']}"
+    assert r["result_image"] and os.path.samefile(r["result_image"], os.path.join(OUT, "halves.exr")), r["result_image"]
+    assert "7" in r["odd"] and "even" in r["odd"] and not r["odd_written"], r["odd"]
+    h0, h1 = (os.path.join(OUT, f"halves_half{k}.exr") for k in (0, 1))
+    mean = (rgb(h0) + rgb(h1)) / 2
+    full = rgb(os.path.join(OUT, "full8.exr"))
+    err = float(np.abs(mean - full).max() / max(1e-6, float(np.abs(full).max())))
+    assert err < 1e-4, f"the halves' mean differs from the 8-spp render by {err} (relative to its maximum)"
+    cli_out = os.path.join(OUT, "cli.exr")
+    p = subprocess.run([cli(), "denoise", h0, "--half", h1, "-f", "box", "-o", cli_out], capture_output=True, text=True,
+                       timeout=120)
+    assert p.returncode == 0, p.stderr
+    got, want = rgb(os.path.join(OUT, "halves.exr")), rgb(cli_out)
+    assert np.array_equal(got, want), f"the add-on's result differs from the CLI's by {np.abs(got - want).max()}"
+    assert np.abs(got - mean).max() > 1e-3, "box changed nothing"
+    print(f"render_halves: 64x48, 8 samples as two halves of 4; their mean vs the 8-spp render {err:.1e}; "
+          f"the result is the CLI's --half bit for bit; settings put back")
+
+
 def check_install_zip():
     r, log = run_blender()
     assert r["has_settings"] and r["panel"]
@@ -504,5 +533,6 @@ def check_install_zip():
  "errors": check_errors, "light_passes": check_light_passes,
  "composite": check_composite, "install_zip": check_install_zip, "hygiene": check_hygiene,
  "png_anim": check_png_anim, "denoise_files": check_denoise_files,
- "composite_before": check_composite_before, "export_deep": check_export_deep}[CASE]()
+ "composite_before": check_composite_before, "export_deep": check_export_deep,
+ "render_halves": check_render_halves}[CASE]()
 print("OK")
