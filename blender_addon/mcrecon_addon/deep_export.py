@@ -20,7 +20,7 @@ import tempfile
 import bpy
 
 from . import native, render_hooks
-from .settings_undo import Undo
+from .settings_undo import Undo, sub_renders
 
 AOV = "mcrecon_z"
 NODE_CAMERA = "mcrecon depth (Camera Data)"
@@ -131,21 +131,9 @@ def export(scene, filepath, samples, progress=None, log=print):
     undo.add(render_hooks.suspend())
     tmpdir = tempfile.mkdtemp(prefix="mcrecon_deep_", dir=bpy.app.tempdir or None)
     try:
-        undo.set(r, "engine", "CYCLES")
-        undo.set(r, "use_compositing", False)
-        undo.set(r, "use_file_extension", True)
-        undo.set(r.image_settings, "file_format", "OPEN_EXR_MULTILAYER")
-        undo.set(r.image_settings, "color_depth", "32")
-        undo.keep(r, "filepath")  # the sub-renders' paths are set below
-        undo.set(cy, "samples", 1)
-        undo.set(cy, "use_adaptive_sampling", False)
-        undo.set(cy, "use_denoising", False)
-        undo.set(cy, "use_animated_seed", False)
+        sub_renders(undo, scene, layer, 1)
         undo.set(cy, "filter_width", 0.01)
-        undo.keep(cy, "sample_offset")
         undo.keep(r, "use_motion_blur")
-        for l in scene.view_layers:
-            undo.set(l, "use", l == layer)
         _depth_aov(scene, layer, undo, log)
         w, h = int(r.resolution_x * r.resolution_percentage / 100), int(r.resolution_y * r.resolution_percentage / 100)
         motion = None

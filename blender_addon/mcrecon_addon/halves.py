@@ -13,7 +13,7 @@ import tempfile
 import bpy
 
 from . import native, properties, render_hooks
-from .settings_undo import Undo
+from .settings_undo import Undo, sub_renders
 
 
 def half_paths(filepath):
@@ -44,20 +44,9 @@ def render_and_denoise(scene, filepath, keep_halves=False, progress=None, log=pr
     undo.add(render_hooks.suspend())
     tmpdir = tempfile.mkdtemp(prefix="mcrecon_halves_", dir=bpy.app.tempdir or None)
     try:
-        undo.set(r, "engine", "CYCLES")
-        undo.set(r, "use_compositing", False)
-        undo.set(r, "use_file_extension", True)
-        undo.set(r.image_settings, "file_format", "OPEN_EXR_MULTILAYER")
-        undo.set(r.image_settings, "color_depth", "32")
-        undo.keep(r, "filepath")
-        undo.set(cy, "samples", samples // 2)
-        if cy.use_adaptive_sampling:  # a pixel that stops early is not two halves of one render
+        if cy.use_adaptive_sampling:
             log("render_halves: adaptive sampling off for the halves (each pixel takes all its samples)")
-        undo.set(cy, "use_adaptive_sampling", False)
-        undo.set(cy, "use_denoising", False)
-        undo.keep(cy, "sample_offset")
-        for vl in scene.view_layers:
-            undo.set(vl, "use", vl == layer)
+        sub_renders(undo, scene, layer, samples // 2)
         rendered = []
         for k in (0, 1):
             cy.sample_offset = k * (samples // 2)

@@ -192,6 +192,21 @@ class MCRECON_OT_render(bpy.types.Operator):
         return {"FINISHED"}
 
 
+def _sub_render_job(op, context, what, total, run):
+    """Runs run(progress, log), an operation of the add-on's own sub-renders, with Blender's
+    progress bar; its failure becomes the operator's error report (None returned)."""
+    mc = native.get()
+    wm = context.window_manager
+    wm.progress_begin(0, total)
+    try:
+        return run(lambda done, n: wm.progress_update(done), lambda m: print("mcrecon: " + m, flush=True))
+    except (ValueError, RuntimeError, mc.Error) as e:
+        op.report({"ERROR"}, f"mcrecon: {what}: {e}" + (f" [{e.kind}]" if isinstance(e, mc.Error) else ""))
+        return None
+    finally:
+        wm.progress_end()
+
+
 class MCRECON_OT_export_deep(bpy.types.Operator):
     """Render the current frame as K one-sample sub-renders and write them as one deep EXR for the per-sample filter sweep (depth of field, motion blur)"""
     bl_idname = "mcrecon.export_deep"
@@ -209,19 +224,11 @@ class MCRECON_OT_export_deep(bpy.types.Operator):
 
     def execute(self, context):
         from . import deep_export
-        mc = native.get()
-        wm = context.window_manager
         total = self.samples + (1 if context.scene.render.use_motion_blur else 0)
-        wm.progress_begin(0, total)
-        try:
-            info = deep_export.export(context.scene, self.filepath, self.samples,
-                                      progress=lambda done, n: wm.progress_update(done),
-                                      log=lambda m: print("mcrecon: " + m, flush=True))
-        except (ValueError, RuntimeError, mc.Error) as e:
-            self.report({"ERROR"}, f"mcrecon: export_deep: {e}" + (f" [{e.kind}]" if isinstance(e, mc.Error) else ""))
+        info = _sub_render_job(self, context, "export_deep", total, lambda progress, log: deep_export.export(
+            context.scene, self.filepath, self.samples, progress=progress, log=log))
+        if info is None:
             return {"CANCELLED"}
-        finally:
-            wm.progress_end()
         self.report({"INFO"}, f"mcrecon: {bpy.path.abspath(self.filepath)}: {info['width']}x{info['height']}, "
                               f"{info['samples']} samples per pixel; denoise with: mcrecon denoise -f sweep")
         return {"FINISHED"}
@@ -244,18 +251,10 @@ class MCRECON_OT_render_halves(bpy.types.Operator):
 
     def execute(self, context):
         from . import halves, render_hooks
-        mc = native.get()
-        wm = context.window_manager
-        wm.progress_begin(0, 3)
-        try:
-            info = halves.render_and_denoise(context.scene, self.filepath, keep_halves=self.keep_halves,
-                                             progress=lambda done, n: wm.progress_update(done),
-                                             log=lambda m: print("mcrecon: " + m, flush=True))
-        except (ValueError, RuntimeError, mc.Error) as e:
-            self.report({"ERROR"}, f"mcrecon: render_halves: {e}" + (f" [{e.kind}]" if isinstance(e, mc.Error) else ""))
+        info = _sub_render_job(self, context, "render_halves", 3, lambda progress, log: halves.render_and_denoise(
+            context.scene, self.filepath, keep_halves=self.keep_halves, progress=progress, log=log))
+        if info is None:
             return {"CANCELLED"}
-        finally:
-            wm.progress_end()
         out = bpy.path.abspath(self.filepath)
         render_hooks.show_result(out, now=True)
         for note in info["notes"]:
