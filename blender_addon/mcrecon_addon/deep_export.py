@@ -15,12 +15,10 @@ the shutter, x right, y up). The camera for the circle of confusion goes into th
 Every setting it changes, every node and AOV it adds, is put back; the sub-renders' files are
 deleted as they are read."""
 import os
-import tempfile
 
 import bpy
 
-from . import native, render_hooks
-from .settings_undo import Undo, sub_renders
+from . import native, sub_render
 
 AOV = "mcrecon_z"
 NODE_CAMERA = "mcrecon depth (Camera Data)"
@@ -126,12 +124,7 @@ def export(scene, filepath, samples, progress=None, log=print):
     if not filepath.lower().endswith(".exr"):
         raise ValueError(f"'{filepath}': the per-sample file is an OpenEXR (.exr)")
     r, cy = scene.render, scene.cycles
-    layer = bpy.context.view_layer if bpy.context.view_layer in scene.view_layers.values() else scene.view_layers[0]
-    undo = Undo("export_deep")
-    undo.add(render_hooks.suspend())
-    tmpdir = tempfile.mkdtemp(prefix="mcrecon_deep_", dir=bpy.app.tempdir or None)
-    try:
-        sub_renders(undo, scene, layer, 1)
+    with sub_render.job(scene, "export_deep", 1) as (undo, layer, tmpdir):
         undo.set(cy, "filter_width", 0.01)
         undo.keep(r, "use_motion_blur")
         _depth_aov(scene, layer, undo, log)
@@ -188,8 +181,3 @@ def export(scene, filepath, samples, progress=None, log=print):
             + (", camera for the circle of confusion" if camera else ", no depth of field")
             + (", motion" if motion is not None else ""))
         return {"samples": samples, "width": w, "height": h, "camera": camera, "motion": motion is not None}
-    finally:
-        undo.restore()
-        for f in os.listdir(tmpdir):
-            os.remove(os.path.join(tmpdir, f))
-        os.rmdir(tmpdir)

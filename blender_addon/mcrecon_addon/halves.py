@@ -8,12 +8,10 @@ Every setting it changes is put back; the halves are deleted unless kept (beside
 <result>_half0.exr and <result>_half1.exr)."""
 import os
 import shutil
-import tempfile
 
 import bpy
 
-from . import native, properties, render_hooks
-from .settings_undo import Undo, sub_renders
+from . import native, properties, render_hooks, sub_render
 
 
 def half_paths(filepath):
@@ -38,15 +36,10 @@ def render_and_denoise(scene, filepath, keep_halves=False, progress=None, log=pr
     mc.check_outputs([filepath] + (list(halves) if keep_halves else []), [])
     settings = scene.mcrecon
     session = mc.Session(settings.filter, properties.filter_params(settings, settings.filter))
-    layer = bpy.context.view_layer if bpy.context.view_layer in scene.view_layers.values() else scene.view_layers[0]
     display = None if filepath.lower().endswith(".exr") else render_hooks.display_settings(scene)
-    undo = Undo("render_halves")
-    undo.add(render_hooks.suspend())
-    tmpdir = tempfile.mkdtemp(prefix="mcrecon_halves_", dir=bpy.app.tempdir or None)
-    try:
-        if cy.use_adaptive_sampling:
-            log("render_halves: adaptive sampling off for the halves (each pixel takes all its samples)")
-        sub_renders(undo, scene, layer, samples // 2)
+    if cy.use_adaptive_sampling:
+        log("render_halves: adaptive sampling off for the halves (each pixel takes all its samples)")
+    with sub_render.job(scene, "render_halves", samples // 2) as (undo, layer, tmpdir):
         rendered = []
         for k in (0, 1):
             cy.sample_offset = k * (samples // 2)
@@ -69,6 +62,3 @@ def render_and_denoise(scene, filepath, keep_halves=False, progress=None, log=pr
             f"{session.filter} ({t['filter_ms']:.0f} ms filter)")
         return {"samples": samples, "half": samples // 2, "filter": session.filter, "timings": t,
                 "notes": list(session.notes()), "halves": list(halves) if keep_halves else []}
-    finally:
-        undo.restore()
-        shutil.rmtree(tmpdir, ignore_errors=True)

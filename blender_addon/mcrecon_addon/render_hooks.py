@@ -15,6 +15,7 @@ filters (bmfr) and the accumulation stage (scene.mcrecon.accumulate) see the fra
 in order, with their history; a frame that does not follow the last one denoised (a frame jump,
 frame_step > 1, or a frame after a failed one) starts a fresh history. Errors become console
 messages and scene.mcrecon.last_message; they never stop Blender writing the render."""
+import contextlib
 import os
 
 import bpy
@@ -27,20 +28,18 @@ RESULT_IMAGE = "mcrecon Result"
 _job = {"session": None, "key": None, "next": None, "warned_before": False, "written": False}  # next: the frame that continues the history
 # Temp results: path -> {"packed": shown and packed, "released": no longer needed for the output}.
 _temps = {}
-_suspended = [0]  # > 0 while the add-on's own operators render (suspend())
+_suspended = [0]  # > 0 while the add-on's own operators render (suspended())
 
 
-def suspend():
-    """The add-on's own sub-renders (the per-sample export, the half buffers) are not the user's
-    renders: no handler denoises or writes them. Returns the call that ends it."""
+@contextlib.contextmanager
+def suspended():
+    """The add-on's own sub-renders (sub_render.job) are not the user's renders: no handler
+    denoises or writes them while this holds."""
     _suspended[0] += 1
-    done = []
-
-    def resume():
-        if not done:
-            done.append(True)
-            _suspended[0] -= 1
-    return resume
+    try:
+        yield
+    finally:
+        _suspended[0] -= 1
 
 
 def log(scene, text, error=False):
@@ -398,8 +397,6 @@ def _denoise_shown_render():
 
 @persistent
 def on_render_cancel(scene, *args):
-    if _suspended[0]:
-        return
     on_render_complete(scene, cancelled=True)
 
 

@@ -106,6 +106,18 @@ bool stands_out_in_own_samples(const Image& colour, const Image& variance, int x
   return d2 / 3.0 > kOutlierSigmas * kOutlierSigmas * own;
 }
 
+std::vector<std::uint8_t> detail_mask(const Image& colour, const Image* variance, const Roi& region, int nthreads) {
+  const int w = colour.width(), h = colour.height();
+  std::vector<std::uint8_t> mask;
+  if (!variance || variance->width() != w || variance->height() != h) return mask;
+  mask.assign(std::size_t(w) * std::size_t(h), 0);
+  const Roi r = region.clipped(w, h);
+  parallel_rows(r.y0, r.y1, nthreads, [&](int y) {
+    for (int x = r.x0; x < r.x1; ++x) mask[std::size_t(y) * std::size_t(w) + std::size_t(x)] = stands_out_in_own_samples(colour, *variance, x, y);
+  });
+  return mask;
+}
+
 double NoiseScales::robust(std::size_t i, int c) const {
   const double m = median[i * 3 + std::size_t(c)];
   return std::min(std::max(double(relative[i]) * (m * m + kRelativeEps), kFloorRelative * kFloorRelative * m * m), 3.0e38);

@@ -87,4 +87,9 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box, int nthre
 // mask): false where the pass or the pixel is not finite, or it has no finite neighbour.
 bool stands_out_in_own_samples(const Image& colour, const Image& variance, int x, int y);
 
+// The firefly clamp's keep mask (prepare/outliers.h): one byte per pixel of the frame, 1 where
+// stands_out_in_own_samples() inside region, 0 elsewhere; empty when there is no variance pass or
+// it is not the colour's size.
+std::vector<std::uint8_t> detail_mask(const Image& colour, const Image* variance, const Roi& region, int nthreads);
+
 }  // namespace mcr

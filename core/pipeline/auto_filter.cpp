@@ -9,7 +9,6 @@
 #include "filters/registry.h"
 #include "kernels/noise_scale.h"
 #include "prepare/outliers.h"
-#include "util/parallel.h"
 
 namespace mcr {
 
@@ -405,16 +404,9 @@ const FilterInfo& AutoFilter::static_info() {
 void AutoFilter::clamp_kept_fireflies(const Frame& frame, const Roi& roi, int nthreads, Image& out) {
   const double k = params_.get_float("kept_firefly_k");
   if (k <= 0) return;
-  std::vector<std::uint8_t> detail;
+  // A pixel its own samples agree on is detail, not a firefly (noise_scale.h).
   const Pass* v = frame.find(Role::Variance);
-  if (v) {  // a pixel its own samples agree on is detail, not a firefly (noise_scale.h)
-    const Roi work = roi.grown(kKeptFireflyRadius, out.width(), out.height());
-    detail.assign(std::size_t(out.width()) * std::size_t(out.height()), 0);
-    parallel_rows(work.y0, work.y1, nthreads, [&](int y) {
-      for (int x = work.x0; x < work.x1; ++x)
-        detail[std::size_t(y) * std::size_t(out.width()) + std::size_t(x)] = stands_out_in_own_samples(out, v->image, x, y);
-    });
-  }
+  const std::vector<std::uint8_t> detail = detail_mask(out, v ? &v->image : nullptr, roi, nthreads);
   const Image before = out;
   clamp_fireflies(out, kKeptFireflyRadius, k, roi, nthreads, detail.empty() ? nullptr : &detail);
   // A clamp by less than relMSE's own floor, sqrt(0.01) in the render's units, is undone: a 2048-spp

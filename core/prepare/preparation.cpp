@@ -258,14 +258,10 @@ void prepare(const Frame& frame, const ParamSet& params, const PrepSteps& steps,
   // With a variance pass, a pixel whose own samples agree as well as its neighbours' is detail
   // however bright (kernels/noise_scale.h, NoiseScales::detail): never clamped as a firefly.
   std::vector<std::uint8_t> detail;
-  if (fireflies)
-    if (const Pass* v = out.frame->find(Role::Variance); v && v->image.width() == w && v->image.height() == h) {
-      detail.assign(std::size_t(w) * std::size_t(h), 0);
-      parallel_rows(work.y0, work.y1, nthreads, [&](int y) {
-        for (int x = work.x0; x < work.x1; ++x)
-          detail[std::size_t(y) * std::size_t(w) + std::size_t(x)] = stands_out_in_own_samples(out.colour, v->image, x, y);
-      });
-    }
+  if (fireflies) {
+    const Pass* v = out.frame->find(Role::Variance);
+    detail = detail_mask(out.colour, v ? &v->image : nullptr, work, nthreads);
+  }
 
   // Albedo demodulation: filter the illumination, not the texture.
   if (steps.demodulate && params.get_bool("demodulate")) {

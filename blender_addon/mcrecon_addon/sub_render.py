@@ -1,4 +1,12 @@
-"""Settings the add-on's own sub-renders change (per-sample export, half buffers), put back."""
+"""The add-on's own sub-renders (the per-sample export, the half buffers): the settings they
+share, put back afterwards, with the render handlers suspended and a temp folder of their own."""
+import contextlib
+import shutil
+import tempfile
+
+import bpy
+
+from . import render_hooks
 
 
 class Undo:
@@ -31,7 +39,7 @@ class Undo:
         self.steps.clear()
 
 
-def sub_renders(undo, scene, layer, samples):
+def _settings(undo, scene, layer, samples):
     """The settings the add-on's own sub-renders share, set through `undo`: Cycles, no compositor,
     32-bit OpenEXR MultiLayer files (every pass), `samples` each without adaptive sampling (a pixel
     that stops early is not a share of one render) or Cycles' denoiser, the same seed, only `layer`;
@@ -50,3 +58,21 @@ def sub_renders(undo, scene, layer, samples):
     undo.keep(cy, "sample_offset")
     for vl in scene.view_layers:
         undo.set(vl, "use", vl == layer)
+
+
+@contextlib.contextmanager
+def job(scene, what, samples):
+    """Yields (undo, layer, tmpdir) for sub-renders of `samples` samples each of the view layer
+    in use, the settings above applied through `undo` and the add-on's render handlers suspended
+    (these renders are not the user's: nothing denoises or writes them); on leaving, every
+    setting is put back and the temp folder removed, whatever happened."""
+    layer = bpy.context.view_layer if bpy.context.view_layer in scene.view_layers.values() else scene.view_layers[0]
+    undo = Undo(what)
+    tmpdir = tempfile.mkdtemp(prefix=f"mcrecon_{what}_", dir=bpy.app.tempdir or None)
+    with render_hooks.suspended():
+        try:
+            _settings(undo, scene, layer, samples)
+            yield undo, layer, tmpdir
+        finally:
+            undo.restore()
+            shutil.rmtree(tmpdir, ignore_errors=True)
