@@ -56,8 +56,16 @@ def render_and_denoise(scene, filepath, keep_halves=False, progress=None, log=pr
         if progress:
             progress(3, 3)
         if keep_halves:
-            for src, dst in zip(rendered, halves):
-                shutil.move(src, dst)
+            for src, dst in zip(rendered, halves):  # beside the output, maybe on another disk:
+                # copied under the core's temp-name convention, then renamed (io/atomic_write.h),
+                # so a kept name never holds a half-written file
+                part = os.path.join(os.path.dirname(dst), f".{os.path.basename(dst)}.mcrecon-tmp.{os.getpid()}")
+                try:
+                    shutil.copyfile(src, part)
+                    os.replace(part, dst)
+                finally:
+                    if os.path.exists(part):
+                        os.remove(part)
         log(f"render_halves: {filepath}: {samples} samples as two halves of {samples // 2}, "
             f"{session.filter} ({t['filter_ms']:.0f} ms filter)")
         return {"samples": samples, "half": samples // 2, "filter": session.filter, "timings": t,
