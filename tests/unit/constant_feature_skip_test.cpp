@@ -15,6 +15,7 @@
 #include "filters/image/guided.h"
 #include "filters/image/pwaf.h"
 #include "filters/registry.h"
+#include "util/error.h"
 
 namespace mcr {
 namespace {
@@ -149,6 +150,39 @@ TEST(ConstantFeatureSkip, GuidedLeavesAConstantPassOutOfTheGuide) {
   const Result normal = run_filter<GuidedFilter>(h, {{"guide", std::string("normal")}});
   EXPECT_TRUE(has_note(skip2, "guided: depth pass is constant over the frame (5.000): left out of the guide"));
   expect_close(skip2.out, normal.out, 1e-5, "normal_depth without the depth");
+}
+
+// The default guide (normal, depth, colour) takes the passes the render has: a pass it lacks is
+// left out as a constant one is (its channel would get coefficient 0), with a note; a guide the
+// user chose still needs every pass it names.
+TEST(ConstantFeatureSkip, GuidedDefaultGuideLeavesAnAbsentPassOut) {
+  Frame h = wall_frame(48, 40, 21);
+  for (int y = 0; y < 40; ++y)
+    for (int x = 0; x < 48; ++x) {
+      float* n = pass_image(h, Role::Normal).pixel(x, y);
+      n[0] = 0.5f * std::sin(0.2f * float(x));
+      n[2] = std::sqrt(1.0f - n[0] * n[0]);
+    }
+  const Params chosen = {{"guide", std::string("normal_depth_colour")}};
+  const Result constant_depth = run_filter<GuidedFilter>(h, chosen);  // depth 5 everywhere
+  const Frame no_depth = without(h, Role::Depth);
+  const Result absent = run_filter<GuidedFilter>(no_depth, {});
+  EXPECT_TRUE(has_note(absent, "guided: depth pass is absent: left out of the guide"));
+  expect_close(absent.out, constant_depth.out, 1e-6, "default guide without a depth pass");
+  EXPECT_GT(changed(absent.out, h.image(Role::Colour)), 0.5);
+
+  // Colour alone: the default guide is the colour guide.
+  const Frame colour_only = without(without(no_depth, Role::Normal), Role::Albedo);
+  const Result bare = run_filter<GuidedFilter>(colour_only, {});
+  const Result colour = run_filter<GuidedFilter>(colour_only, {{"guide", std::string("colour")}});
+  EXPECT_TRUE(has_note(bare, "guided: normal pass is absent: left out of the guide"));
+  expect_close(bare.out, colour.out, 0.0, "default guide on colour alone");
+
+  // A guide the user chose needs its passes.
+  GuidedFilter g;
+  g.set("guide", std::string("normal_depth_colour"));
+  g.commit();
+  EXPECT_THROW(g.execute(no_depth), Error);
 }
 
 TEST(ConstantFeatureSkip, GuidedKeepsAGuideWhenEveryPassIsConstant) {

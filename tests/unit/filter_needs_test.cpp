@@ -29,6 +29,9 @@ TEST(FilterNeeds, FollowTheSettings) {
   const PassNeeds nd = committed("guided", {{"guide", "normal_depth"}})->needs();
   EXPECT_TRUE(has(nd.required, Role::Normal));
   EXPECT_TRUE(has(nd.required, Role::Depth));
+  const PassNeeds def = committed("guided", {})->needs();  // the default guide takes what is there
+  EXPECT_EQ(def.required, std::vector<Role>{Role::Colour});
+  EXPECT_TRUE(has(def.optional, Role::Normal) && has(def.optional, Role::Depth));
   const PassNeeds lum = committed("guided", {{"guide", "luminance"}})->needs();
   EXPECT_EQ(lum.required, std::vector<Role>{Role::Colour});
 

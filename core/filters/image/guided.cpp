@@ -256,7 +256,8 @@ const FilterInfo& GuidedFilter::static_info() {
                         "colour guide by the noisy colour itself (He et al.'s self-guided case); "
                         "normal_depth_colour (default) adds the colour to normal + depth, so shadows, glossy "
                         "reflections and lighting the features do not show are kept where they stand above the "
-                        "noise; each pass is "
+                        "noise (the default takes the passes the render has: a pass it lacks is left out with a note, the colour "
+                        "guide when there is none; a guide set here needs all of its passes); each pass is "
                         "centred on its frame mean, depth/position/luminance/colour divided by their std (a colour "
                         "guide under epsilon=0 by max(std, its level)), normal/albedo by max(1, std)"),
         ParamSpec::Int("radius", 4, 1, 256, "half width of the box window in pixels (window = 2r+1); O(N): run time nearly independent of it"),
@@ -296,7 +297,13 @@ PassNeeds GuidedFilter::own_needs() const {
   PassNeeds n;
   n.require(Role::Colour);
   const std::string& guide = params_.get_enum("guide");
-  for (Role r : guide_passes(guide)) n.require(r, "guide=" + guide + "; guide=luminance needs no feature pass");
+  // The default guide takes the passes the render has (the others are left out with a note, as a
+  // constant pass is); a guide the user chose needs all of its passes.
+  const bool chosen = params_.was_set("guide");
+  for (Role r : guide_passes(guide)) {
+    if (chosen) n.require(r, "guide=" + guide + "; guide=luminance needs no feature pass");
+    else n.use(r);
+  }
   return n;
 }
 
@@ -308,7 +315,7 @@ std::vector<std::string> GuidedFilter::own_unused() const {
 
 void GuidedFilter::run(const Frame& frame, const Image& colour_in, const Roi& roi, Image& out, int nthreads) {
   const std::string& guide = params_.get_enum("guide");
-  const GuideChoice& choice = find_choice(guide);  // its passes: checked by needs() before any work
+  const GuideChoice& choice = find_choice(guide);  // a chosen guide's passes: checked by needs() before any work
   const int W = frame.width, H = frame.height;
   const int r = int(params_.get_int("radius"));
   const Image* colour = &colour_in;

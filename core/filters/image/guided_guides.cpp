@@ -66,13 +66,13 @@ std::vector<GroupSpec> active_groups(const GuideChoice& choice, const Frame& fra
   const GroupSpec* smallest = nullptr;
   const Roi all = Roi::all(frame.width, frame.height);
   for (const GroupSpec& g : choice.groups) {
-    if (!smallest || g.channels < smallest->channels) smallest = &g;
-    if (!reads_pass(g.source)) {
-      kept.push_back(g);
+    const Pass* pass = reads_pass(g.source) ? frame.find(source_role(g.source)) : nullptr;
+    if (reads_pass(g.source) && !pass) {  // the default guide on a render without this pass (a chosen guide's are checked first)
+      dropped.push_back(std::string(role_name(source_role(g.source))) + " pass is absent: left out of the guide");
       continue;
     }
-    const Pass* pass = frame.find(source_role(g.source));
-    if (!pass) {  // needs() has checked: not reached
+    if (!smallest || g.channels < smallest->channels) smallest = &g;
+    if (!pass) {
       kept.push_back(g);
       continue;
     }
@@ -84,7 +84,7 @@ std::vector<GroupSpec> active_groups(const GuideChoice& choice, const Frame& fra
     }
     dropped.push_back(activity_note(role_name(pass->role), a, all, frame.width, frame.height, "left out of the guide"));
   }
-  if (kept.empty()) {
+  if (kept.empty() && smallest) {
     kept.push_back(*smallest);
     note("guided: no guide pass varies over the frame; the " + std::string(role_name(source_role(smallest->source))) +
          " pass stays as the guide (the result is the box-of-box mean of the colour)");

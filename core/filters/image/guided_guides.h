@@ -32,7 +32,8 @@ Role source_role(Source s);
 bool reads_pass(Source s);
 
 // The groups of `choice` that carry information in `frame` (kernels/feature_activity.h),
-// in order. A pass group is left out, with a note, when its pass has no finite value or
+// in order. A pass group is left out, with a note, when the frame lacks its pass (the default
+// guide only: a guide the user chose needs its passes, GuidedFilter::own_needs), has no finite value or
 // is constant over the frame: within 0.004 sqrt(epsilon) for normal and albedo (scaled
 // by max(1, std), so a spread t moves the ridge solution by about t^2 / epsilon, under
 // 2e-5), within 0.49e-5 relative (float rounding) for depth and position, which are
