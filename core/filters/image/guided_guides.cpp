@@ -63,19 +63,19 @@ std::vector<GroupSpec> active_groups(const GuideChoice& choice, const Frame& fra
                                      const std::function<void(std::string)>& note) {
   std::vector<GroupSpec> kept;
   std::vector<std::string> dropped;
-  const GroupSpec* smallest = nullptr;
+  const GroupSpec* smallest = nullptr;  // the present pass group with the fewest channels
   const Roi all = Roi::all(frame.width, frame.height);
   for (const GroupSpec& g : choice.groups) {
-    const Pass* pass = reads_pass(g.source) ? frame.find(source_role(g.source)) : nullptr;
-    if (reads_pass(g.source) && !pass) {  // the default guide on a render without this pass (a chosen guide's are checked first)
+    if (!reads_pass(g.source)) {  // the colour itself: always kept
+      kept.push_back(g);
+      continue;
+    }
+    const Pass* pass = frame.find(source_role(g.source));
+    if (!pass) {  // the default guide on a render without this pass (a chosen guide's are checked first)
       dropped.push_back(std::string(role_name(source_role(g.source))) + " pass is absent: left out of the guide");
       continue;
     }
     if (!smallest || g.channels < smallest->channels) smallest = &g;
-    if (!pass) {
-      kept.push_back(g);
-      continue;
-    }
     const Tolerance tol = g.unit ? Tolerance(constant_tolerance(std::sqrt(epsilon))) : Tolerance(0.0, 0.49e-5);
     const FeatureActivity a = feature_activity(pass->image, g.channels, all, tol, nthreads);
     if (a.kind == Activity::Varies) {
