@@ -100,11 +100,13 @@ int main(int argc, char** argv) {
     std::printf("%-9s %-6s %-10s %9s %9s %10.5f\n", scene.name.c_str(), scene.split.c_str(), "(noisy)", "-", "-",
                 mcr::relmse(ref, frame.image(mcr::Role::Colour).channel_range(0, 3), threads));
     const Run a = time_filter("auto", frame, ref, threads, repeat);
+    // What auto picked: one filter, or two ("a+b", the mean of their results) whose times add.
+    const std::vector<std::string> picks = mcr::bench::split_list(a.chosen, '+');
     double picked = 0;
     for (const std::string& name : mcr::image_filter_names()) {
       if (mcr::filter_info(name).temporal || mcr::filter_info(name).deep_input) continue;
       const Run r = time_filter(name, frame, ref, threads, repeat);
-      if (name == a.chosen) picked = r.seconds;
+      if (std::find(picks.begin(), picks.end(), name) != picks.end()) picked += r.seconds;
       std::printf("%-9s %-6s %-10s %9.4f %9.4f %10.5f\n", scene.name.c_str(), scene.split.c_str(), name.c_str(), r.seconds,
                   r.seconds / mp, r.relmse);
     }

@@ -22,8 +22,9 @@ const Sweep& sweep_for(const std::string& filter);
 // variants ("", firefly_k=2, firefly_k=1), then the filter's own.
 std::vector<std::string> sweep_variants(const std::string& filter);
 
-// "a,b" -> {"a", "b"} (empty items dropped), for --scenes / --filters.
-std::vector<std::string> split_list(const std::string& s);
+// "a,b" -> {"a", "b"} (empty items dropped), for --scenes / --filters; sep '+' splits auto's
+// choice of two filters.
+std::vector<std::string> split_list(const std::string& s, char sep = ',');
 // True when `list` is empty (everything wanted) or holds `name`.
 bool wanted(const std::vector<std::string>& list, const std::string& name);
 // Sets every key=value of `variant` ("k=v k=v") on the filter; returns them space-separated.

@@ -18,7 +18,9 @@
 //       excursion and the filter's response to it instead of a derivative; e, the input's
 //       error there, its noise variance (at most 16x its 3x3 range squared) or a far-out
 //       pixel's squared distance to its median (.cpp).
-//  3. Run the best on the whole region, or copy the input when its own estimated relMSE
+//     Besides each filter, the mean of every two (pairs): scored from their two runs, with no
+//     run of its own (every score is linear in the result; .cpp).
+//  3. Run the best (one filter, or two and their mean) on the whole region, or copy the input when its own estimated relMSE
 //     is below `converged` (held out, without far-out pixels where they are under 1 in
 //     1000: a converged render's rare glints) or the best is not estimated to cut it by min_gain: with a
 //     variance pass by its SURE score, without by a blind-spot check, its result at the
@@ -34,9 +36,9 @@
 namespace mcr {
 
 struct AutoScore {
-  std::string filter;       // "input" for the input itself
+  std::string filter;       // "input" for the input itself, "a+b" for the mean of filters a and b
   double relmse = 0;        // estimated relMSE on the sample
-  double seconds = 0;       // time of its two runs on the sample
+  double seconds = 0;       // time of its two runs on the sample (a mean: both filters')
 };
 
 // The blind-spot check of the best-scored filter (run only without a variance pass).
@@ -59,7 +61,8 @@ class AutoFilter : public Filter {
   static const FilterInfo& static_info();
   // The scores of the last execute(), best first (empty when nothing was scored).
   const std::vector<AutoScore>& scores() const { return scores_; }
-  // The filter the last execute() ran ("input" when it copied the input).
+  // The filter the last execute() ran ("input" when it copied the input; "a+b" for the mean of
+  // filters a and b, as its score is named).
   const std::string& chosen() const { return chosen_; }
   // The blind-spot check of the last execute() (filter empty when it did not run).
   const AutoCheck& check() const { return check_; }

@@ -120,7 +120,9 @@ def check_render(filter_name, box_radius=None):
         f"(max |d| {np.abs(got - want_px).max()})"
     if filter_name == "auto":  # its report reaches the console, naming a filter it ran
         chose = re.findall(r"mcrecon: auto: chose (?:the )?(\S+)", log)
-        assert len(chose) == 1 and chose[0] in mcrecon.filter_names() + ["input"], log[-3000:]
+        # one filter, the input, or "a+b": the mean of two filters' results
+        assert len(chose) == 1 and (chose[0] in mcrecon.filter_names() + ["input"] or all(
+            n in mcrecon.filter_names() for n in chose[0].split("+"))), log[-3000:]
         # ... and the frame's line (the status bar's text too) names it
         shown = "kept the input" if chose[0] == "input" else chose[0]
         assert re.search(r"mcrecon: auto: %s frame \d+: " % re.escape(shown), log), log[-3000:]

@@ -149,7 +149,7 @@ def test_auto_reports_its_choice(tmp):
     name the filter it ran; the output is that filter's, bit for bit (the oracle for the report)."""
     assert "auto" in mcrecon.filter_names() and mcrecon.filter_names()[-1] == "auto", mcrecon.filter_names()
     info = mcrecon.filter_info("auto")
-    assert {p["name"] for p in info["parameters"]} == {"sample_fraction", "converged", "min_gain", "kept_firefly_k",
+    assert {p["name"] for p in info["parameters"]} == {"sample_fraction", "converged", "min_gain", "kept_firefly_k", "pairs",
                                                        "exposure", "components", "alpha"}, info["parameters"]
     assert info in mcrecon.filters()
     out = os.path.join(tmp, "auto_py.exr")

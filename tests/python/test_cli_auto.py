@@ -69,10 +69,12 @@ class AutoCliTest(unittest.TestCase):
         self.assertEqual(auto["required_passes"], ["colour"])
         self.assertFalse(auto["temporal"])
         params = {p["name"]: p for p in auto["parameters"]}
-        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "kept_firefly_k", "exposure", "components", "alpha"})
+        self.assertEqual(set(params), {"sample_fraction", "converged", "min_gain", "kept_firefly_k", "pairs", "exposure", "components", "alpha"})
         self.assertEqual(params.pop("components")["choices"], ["beauty", "light_passes"])  # every filter's
         self.assertEqual(params.pop("exposure")["choices"], ["auto", "off"])  # every image filter's
         self.assertEqual(params.pop("alpha")["choices"], ["filter", "keep"])  # every flat-frame filter's
+        pairs = params.pop("pairs")
+        self.assertEqual((pairs["type"], pairs["default"]), ("bool", True))
         for p in params.values():
             self.assertEqual(p["type"], "float")
             self.assertLessEqual(p["min"], p["default"])
