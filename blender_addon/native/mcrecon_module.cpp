@@ -518,7 +518,8 @@ PYBIND11_MODULE(mcrecon, m) {
            "settings given that have no effect, then the notes of the last run (filter, accumulation)")
       .def("chosen", &Session::chosen,
            "filter 'auto': what it ran in the last run, per stage ({'beauty': 'atrous'}, or the light stages' "
-           "with components=light_passes; 'input' where it kept the input); None for another filter")
+           "with components=light_passes; 'input' where it kept the input, 'atrous+pwaf' where it ran the mean of two); "
+           "None for another filter")
       .def("reset", &Session::reset, "drop temporal history (new shot)")
       .def(
           "denoise",
