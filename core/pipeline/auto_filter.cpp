@@ -355,19 +355,20 @@ void held_out_sums(const Sample& s, const Image& f, const Image& fj, HeldOut& su
     }
 }
 
-// The mean of two candidates' results (same size): scored and run as a candidate of its own.
-// Two filters err differently (a regression keeps edges a bilateral blurs, and the other way
+// a := (a + b) / 2 inside r (a and b the same size): the mean of two candidates' results, scored
+// (on a tile) and run (inside the region; outside it both hold the input) as a candidate of its
+// own. Two filters err differently (a regression keeps edges a bilateral blurs, and the other way
 // at a highlight), so their mean's error is often below either's: over the 13 stills at 4, 16
 // and 64 spp the best mean of two had 0.61-1.15x the best single filter's relMSE (median 0.91).
 // Every score is linear in the result (SURE's probe, the held-out response and check alike), so
 // the mean is scored from the two runs already made, with no run of its own.
-Image mean_of(const Image& a, const Image& b) {
-  Image m = a;
-  const std::size_t n = std::size_t(a.width()) * std::size_t(a.height()) * std::size_t(a.channels());
-  float* o = m.data();
-  const float* q = b.data();
-  for (std::size_t i = 0; i < n; ++i) o[i] = 0.5f * o[i] + 0.5f * q[i];
-  return m;
+void average_into(Image& a, const Image& b, const Roi& r) {
+  const std::size_t row = std::size_t(r.width()) * std::size_t(a.channels());
+  for (int y = r.y0; y < r.y1; ++y) {
+    float* o = a.pixel(r.x0, y);
+    const float* q = b.pixel(r.x0, y);
+    for (std::size_t i = 0; i < row; ++i) o[i] = 0.5f * o[i] + 0.5f * q[i];
+  }
 }
 
 }  // namespace
@@ -486,16 +487,17 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   }
   const double n = std::max<double>(double(count), 1.0);
   const bool sure = !samples.front().held_out();  // a variance pass, or a region under 8x8 (every tile alike)
-  // A candidate: one filter (second < 0) or the mean of two (first < second).
+  // A candidate: one filter (second < 0) or the mean of two (first < second), named as scored.
   struct Choice {
     int first, second;
+    std::string name;
   };
   std::vector<Choice> choices;
   std::vector<double> estimate, check;  // per choice, relMSE per channel
   std::vector<double> seconds(cands.size());
   // Each candidate's two results on each sample (the frame's, then the probed or masked one's).
   std::vector<std::vector<std::pair<Image, Image>>> results(cands.size());
-  auto score = [&](const std::vector<std::pair<Image, Image>>& res, const std::string& name, double secs) {
+  auto score = [&](const std::vector<std::pair<Image, Image>>& res, Choice choice, double secs) {
     double r = 0;
     HeldOut h;
     for (std::size_t k = 0; k < samples.size(); ++k) {
@@ -506,7 +508,8 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     }
     estimate.push_back((sure ? r : h.score) / n);
     check.push_back(h.check / n);
-    scores_.push_back({name, estimate.back(), secs});
+    scores_.push_back({choice.name, estimate.back(), secs});
+    choices.push_back(std::move(choice));
   };
   for (std::size_t c = 0; c < cands.size(); ++c) {
     Filter& f = *cands[c];
@@ -519,18 +522,17 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
       results[c].emplace_back(std::move(a), f.execute(sure ? s.probed : s.masked, eo));
     }
     seconds[c] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    choices.push_back({int(c), -1});
-    score(results[c], f.info().name, seconds[c]);
+    score(results[c], {int(c), -1, f.info().name}, seconds[c]);
   }
   if (params_.get_bool("pairs"))
     for (std::size_t a = 0; a < cands.size(); ++a)
       for (std::size_t b = a + 1; b < cands.size(); ++b) {
-        std::vector<std::pair<Image, Image>> mean;
-        for (std::size_t k = 0; k < samples.size(); ++k)
-          mean.emplace_back(mean_of(results[a][k].first, results[b][k].first),
-                            mean_of(results[a][k].second, results[b][k].second));
-        choices.push_back({int(a), int(b)});
-        score(mean, cands[a]->info().name + "+" + cands[b]->info().name, seconds[a] + seconds[b]);
+        std::vector<std::pair<Image, Image>> mean = results[a];
+        for (std::size_t k = 0; k < samples.size(); ++k) {
+          average_into(mean[k].first, results[b][k].first, samples[k].inner);
+          average_into(mean[k].second, results[b][k].second, samples[k].inner);
+        }
+        score(mean, {int(a), int(b), cands[a]->info().name + "+" + cands[b]->info().name}, seconds[a] + seconds[b]);
       }
   results.clear();
   scores_.push_back({"input", in_sum / n, 0.0});
@@ -564,13 +566,9 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   // The first of the lowest, as the stable sort above lists them.
   const std::size_t best = std::size_t(std::min_element(estimate.begin(), estimate.end()) - estimate.begin());
   const std::size_t nchoices = choices.size();
-  auto choice_name = [&](std::size_t i) {
-    const Choice& ch = choices[i];
-    return cands[std::size_t(ch.first)]->info().name + (ch.second < 0 ? "" : "+" + cands[std::size_t(ch.second)]->info().name);
-  };
   double best_estimate = best < nchoices ? estimate[best] : 0.0;
   if (best < nchoices && !sure) {
-    const std::string name = choice_name(best);
+    const std::string& name = choices[best].name;
     best_estimate = check[best];
     check_ = {name, check[best], input_score};
     note("auto: check of " + name + " (its result at the held-out pixels made from their neighbours alone): estimated relMSE " +
@@ -585,7 +583,7 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
   const double min_gain = params_.get_float("min_gain");
   if (best < nchoices && !sure && !(estimate[best] <= (1.0 + min_gain) * input_score)) {
     chosen_ = "input";
-    note("auto: chose the input as it is: no filter ranks within min_gain of it (" + choice_name(best) + " " +
+    note("auto: chose the input as it is: no filter ranks within min_gain of it (" + choices[best].name + " " +
          rounded_text(estimate[best], 3) + " against " + rounded_text(input_score, 3) + ")");
     clamp_kept_fireflies(frame, roi, nthreads, out);
     return;
@@ -597,31 +595,18 @@ void AutoFilter::run(const Frame& frame, const Image& colour, const Roi& roi, Im
     clamp_kept_fireflies(frame, roi, nthreads, out);  // out holds the input colour
     return;
   }
-  chosen_ = choice_name(best);
+  const Choice& ch = choices[best];
+  chosen_ = ch.name;
   ExecOptions eo;
   eo.roi = roi;
   eo.nthreads = nthreads;
-  const Choice ch = choices[best];
-  Filter& f = *cands[std::size_t(ch.first)];
-  out = f.execute(frame, eo);
-  if (ch.second >= 0) {
-    Filter& g = *cands[std::size_t(ch.second)];
-    const Image other = g.execute(frame, eo);
-    // Inside the region only: outside it both results hold the input.
-    const Roi r = roi.clipped(out.width(), out.height());
-    for (int y = r.y0; y < r.y1; ++y) {
-      float* o = out.pixel(r.x0, y);
-      const float* q = other.pixel(r.x0, y);
-      for (std::size_t i = 0; i < std::size_t(r.width()) * std::size_t(out.channels()); ++i) o[i] = 0.5f * o[i] + 0.5f * q[i];
-    }
-    note("auto: chose " + chosen_ + " (the mean of the two results) with their defaults");
-  } else {
-    note("auto: chose " + chosen_ + " with its defaults");
-  }
-  for (const Filter* c : {&f, ch.second >= 0 ? cands[std::size_t(ch.second)].get() : nullptr}) {
-    if (!c) continue;
-    const std::string& name = c->info().name;
-    for (const std::string& m : c->notes()) note(m.rfind(name + ":", 0) == 0 ? m : name + ": " + m);
+  out = cands[std::size_t(ch.first)]->execute(frame, eo);
+  if (ch.second >= 0) average_into(out, cands[std::size_t(ch.second)]->execute(frame, eo), roi.clipped(out.width(), out.height()));
+  note("auto: chose " + chosen_ + (ch.second < 0 ? " with its defaults" : " (the mean of the two results) with their defaults"));
+  for (const int i : {ch.first, ch.second}) {
+    if (i < 0) continue;
+    const std::string& name = cands[std::size_t(i)]->info().name;
+    for (const std::string& m : cands[std::size_t(i)]->notes()) note(m.rfind(name + ":", 0) == 0 ? m : name + ": " + m);
   }
 }
 
