@@ -2,13 +2,32 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "util/error.h"
 
 namespace mcr {
 
 namespace {
+
+// A pixel is a spike when one sample's squared deviation from the pixel's mean is more than this
+// share of all its samples' (in any channel): a rare path, which stratification does not make
+// less variable (.h).
+constexpr double kSpikeShare = 0.5;
+constexpr double kRelMseEps = 0.01;  // relMSE's term: (x - r)^2 / (r^2 + 0.01)
+
+// (A - B)^2 n1 n2 / n^2 for the first n1 = n / 2 of s[0, n) against the rest: in expectation the
+// variance of their mean where the two halves are independent (n >= 2).
+double halves_estimate(const float* s, std::size_t n) {
+  const std::size_t n1 = n / 2, n2 = n - n1;
+  double a = 0, b = 0;
+  for (std::size_t i = 0; i < n1; ++i) a += s[i];
+  for (std::size_t i = n1; i < n; ++i) b += s[i];
+  const double d = a / double(n1) - b / double(n2);
+  return d * d * double(n1) * double(n2) / (double(n) * double(n));
+}
 
 // Passes Blender writes from a pixel's first sample only (with sample_offset > 0 its Depth is
 // 1e10 and its Position 0): the first half's are the whole render's. Geometry at one hit is
@@ -88,11 +107,17 @@ std::optional<Pass> sample_halves_variance(const DeepSamples& deep, const Pass& 
   var.source = colour.source;
   var.channels = {"variance.R", "variance.G", "variance.B"};
   var.image = Image(deep.width, deep.height, 3);
+  // Over the pixels whose variance is not one sample's, R, G, B weighed as relMSE weighs them:
+  // the halves' own estimates as the variance of a mean of n samples (a) and the whole's (b).
+  double a = 0, b = 0;
+  std::vector<std::uint8_t> corrected(std::size_t(deep.width) * std::size_t(deep.height), 0);
   std::vector<float> finite;
   for (int y = 0; y < deep.height; ++y)
     for (int x = 0; x < deep.width; ++x) {
       const std::uint64_t first = deep.first(x, y), n_all = deep.samples(x, y);
       float* v = var.image.pixel(x, y);
+      double pa = 0, pb = 0;
+      bool spike = false, rate = true;
       for (int c = 0; c < 3; ++c) {
         finite.clear();
         const std::vector<float>& s = deep.values[std::size_t(ch[c])];
@@ -101,14 +126,46 @@ std::optional<Pass> sample_halves_variance(const DeepSamples& deep, const Pass& 
         const std::size_t n = finite.size(), n1 = n / 2, n2 = n - n1;
         if (n1 == 0) {
           v[c] = std::numeric_limits<float>::quiet_NaN();
+          rate = false;
           continue;
         }
-        double a = 0, b = 0;
-        for (std::size_t i = 0; i < n1; ++i) a += finite[i];
-        for (std::size_t i = n1; i < n; ++i) b += finite[i];
-        const double d = a / double(n1) - b / double(n2);
-        v[c] = float(std::min(d * d * double(n1) * double(n2) / (double(n) * double(n)), 3.0e38));
+        const double whole = halves_estimate(finite.data(), n);
+        v[c] = float(std::min(whole, 3.0e38));
+        double mean = 0;
+        for (float f : finite) mean += f;
+        mean /= double(n);
+        double sum2 = 0, max2 = 0;
+        for (float f : finite) {
+          const double d2 = (double(f) - mean) * (double(f) - mean);
+          sum2 += d2;
+          max2 = std::max(max2, d2);
+        }
+        spike = spike || max2 > kSpikeShare * sum2;
+        if (n1 < 2) {
+          rate = false;
+          continue;
+        }
+        const double w = 1.0 / (mean * mean + kRelMseEps);
+        pa += w * (halves_estimate(finite.data(), n1) * double(n1) + halves_estimate(finite.data() + n1, n2) * double(n2)) /
+              double(n);
+        pb += w * whole;
       }
+      if (spike) continue;
+      corrected[std::size_t(y) * std::size_t(deep.width) + std::size_t(x)] = 1;
+      if (rate && std::isfinite(pa) && std::isfinite(pb)) {
+        a += pa;
+        b += pb;
+      }
+    }
+  if (!(b > 0) || !std::isfinite(a)) return var;
+  // Var(mean of n) ~ n^-alpha: the halves' estimates over the whole's read 2^alpha (2 for
+  // independent samples); the whole's estimate over its true variance is 2^alpha - 1 (.h).
+  const double ratio = std::min(std::max(a / b, 2.0), 4.0);
+  for (int y = 0; y < deep.height; ++y)
+    for (int x = 0; x < deep.width; ++x) {
+      if (!corrected[std::size_t(y) * std::size_t(deep.width) + std::size_t(x)]) continue;
+      float* v = var.image.pixel(x, y);
+      for (int c = 0; c < 3; ++c) v[c] = float(double(v[c]) / (ratio - 1.0));
     }
   return var;
 }

@@ -252,6 +252,8 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
   // window of every pixel near it (the step back and auto treat it by itself).
   const Roi E = s.box.grown(kVarianceRadius + 1, W, H);
   std::vector<float> exc(std::size_t(E.width()) * std::size_t(E.height()), 0.0f);
+  // The same above the range only: an outlier must be brighter than its neighbours (.h).
+  std::vector<std::uint8_t> above(exc.size(), 0);
   auto tile_of = [&](int x, int yy) {
     const int tx = std::min(std::max((x - gx0) / kTile, 0), ntx - 1);
     const int ty = std::min(std::max((yy - gy0) / kTile, 0), nty - 1);
@@ -265,14 +267,17 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       float lo[3], hi[3];
       const bool any = neighbour_range(y, ok, x, yy, lo, hi);
       const double rel = tile_of(x, yy);
-      double dev = 0;
+      double dev = 0, up = 0;
       for (int c = 0; c < 3; ++c) {
         const double m = med[i * 3 + std::size_t(c)];
         const double robust = std::min(std::max(rel * (m * m + kRelativeEps), kFloorRelative * kFloorRelative * m * m), 3.0e38);
         const double out = any ? double(p[c]) - std::min(std::max(p[c], lo[c]), hi[c]) : 0.0;
         dev += out * out / std::max(robust, 1e-30);
+        if (out > 0) up += out * out / std::max(robust, 1e-30);
       }
-      exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)] = float(std::min(dev / 3.0, 3.0e38));
+      const std::size_t e = std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0);
+      exc[e] = float(std::min(dev / 3.0, 3.0e38));
+      above[e] = up / 3.0 > kOutlierSigmas * kOutlierSigmas;
     }
   });
   // Where outliers are many (a 1-spp render lit by rare paths), they are the noise itself and
@@ -365,11 +370,11 @@ NoiseScales estimate_noise_scales(const Image& colour, const Roi& box_in, int nt
       if (demod)
         for (int c = 0; c < 3; ++c) s.albedo[o * 3 + std::size_t(c)] = albedo_at(x, yy, c);
       s.relative[o] = tile_of(x, yy);
-      const float e = exc[std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0)];
-      s.excess[o] = e;
+      const std::size_t ei = std::size_t(yy - E.y0) * std::size_t(E.width()) + std::size_t(x - E.x0);
+      s.excess[o] = exc[ei];
       s.variance[o] = float(std::min(std::max(z.mean(x - V.x0, yy - V.y0) * level(x, yy), 0.0), 3.0e38));
       if (use_pass) s.detail[o] = stands_out_in_own_samples(colour, *vpass, x, yy);
-      s.outlier[o] = e > kOutlierSigmas * kOutlierSigmas && !s.detail[o] ? 1 : 0;
+      s.outlier[o] = above[ei] && !s.detail[o] ? 1 : 0;
     }
   });
   return s;

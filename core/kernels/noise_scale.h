@@ -31,10 +31,14 @@
 //                B): its own samples agree that it stands out, so it is detail (a clean
 //                render's aliasing), not a firefly, whose own samples disagree by about
 //                its distance (one sample F of n: distance ~ F/n, own deviation ~ F/n).
-//   outlier(p)   y(p) lies beyond the range of its 8 finite neighbours by more than 4
-//                robust deviations (mean over R, G, B of the squared excess > 16 robust(p)),
-//                and is not detail(p): a firefly (or a one-pixel highlight); a block's
-//                corner is not one.
+//   outlier(p)   y(p) lies above the range of its 8 finite neighbours by more than 4
+//                robust deviations (mean over R, G, B of the squared excess above it > 16
+//                robust(p)), and is not detail(p): a firefly (or a one-pixel highlight); a
+//                block's corner is not one. Only above: Monte Carlo's outliers are bright (a
+//                rare path adds light), while a pixel below its neighbours is noise at an edge
+//                or in a shadow that a filter's result need not fix (per-sample dof_garden's
+//                largest losses to pwaf were dark corner pixels given the blur of their bright
+//                side); the step back weighs it like any other pixel.
 //
 // Non-finite pixels take no part in any neighbourhood; at a non-finite pixel every scale
 // is 0 and outlier is false. Deterministic: no reduction depends on the thread count.
@@ -53,7 +57,7 @@ struct NoiseScales {
   std::vector<std::uint8_t> finite; // the pixel's RGB is finite
   std::vector<float> excess;        // mean over R, G, B of (distance beyond the neighbours' range)^2 / robust
   std::vector<std::uint8_t> detail;  // a variance pass says it stands out in its own samples
-  std::vector<std::uint8_t> outlier; // excess > kOutlierSigmas^2 and not detail
+  std::vector<std::uint8_t> outlier; // excess above the range > kOutlierSigmas^2, not detail
   std::size_t at(int x, int y) const {
     return std::size_t(y - box.y0) * std::size_t(box.width()) + std::size_t(x - box.x0);
   }

@@ -4,10 +4,12 @@ pixel filter (every sample at the pixel centre, as in the deep file), raw Combin
 
     blender -b --factory-startup --python-exit-code 1 --python per_sample.py -- \\
         --scene dof|motion|dof_garden|dof_spheres --out DIR --addon-dir build/blender_addon/stage \\
-        [--spp 16] [--ref-spp 1024] [--width 128] [--height 96]
+        [--spp 16] [--ref-spp 1024] [--width 128] [--height 96] [--draw N]
 
-Writes DIR/<scene>_<spp>spp_deep.exr and DIR/<scene>_ref.exr, and prints one JSON line
-("per_sample": ...) with the render times."""
+Writes DIR/<scene>_<spp>spp_deep.exr and DIR/<scene>_ref.exr (none with --ref-spp 0), and prints
+one JSON line ("per_sample": ...) with the render times. --draw N > 0 renders another draw of the
+samples (other seeds) as DIR/<scene>_<spp>spp_draw<N>_deep.exr, to test a setting on samples
+nothing was chosen on; the reference is the same scene's."""
 import argparse
 import importlib
 import json
@@ -32,6 +34,7 @@ def main():
     p.add_argument("--ref-spp", type=int, default=1024)
     p.add_argument("--width", type=int, default=128)
     p.add_argument("--height", type=int, default=96)
+    p.add_argument("--draw", type=int, default=0, help="another draw of the samples: N > 0 seeds (and names) them apart")
     a = p.parse_args(argv)
     sys.path.insert(0, os.path.abspath(a.addon_dir))
     addon_utils.enable("mcrecon_addon", default_set=False, handle_error=None)
@@ -43,13 +46,18 @@ def main():
         mod.configure(scene)
     os.makedirs(a.out, exist_ok=True)
     times = {}
-    scene.cycles.seed = C.seed_for(a.scene, "deep", a.spp)
+    draw = f"_draw{a.draw}" if a.draw else ""
+    scene.cycles.seed = C.seed_for(a.scene + draw, "deep", a.spp)
     t0 = time.time()
-    deep = os.path.join(os.path.abspath(a.out), f"{a.scene}_{a.spp}spp_deep.exr")
+    deep = os.path.join(os.path.abspath(a.out), f"{a.scene}_{a.spp}spp{draw}_deep.exr")
     result = bpy.ops.mcrecon.export_deep(filepath=deep, samples=a.spp)
     if result != {"FINISHED"}:
         sys.exit(f"export_deep failed: {result}")
     times["deep"] = round(time.time() - t0, 3)
+    if a.ref_spp <= 0:
+        print("per_sample: " + json.dumps({"scene": a.scene, "width": a.width, "height": a.height, "spp": a.spp,
+                                           "draw": a.draw, "seconds": times}), flush=True)
+        return
     # The reference: the same pixel filter, many samples, raw Combined.
     scene.cycles.seed = C.seed_for(a.scene, "ref", a.ref_spp)
     scene.cycles.samples = a.ref_spp

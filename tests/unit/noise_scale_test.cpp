@@ -123,6 +123,20 @@ TEST(NoiseScale, FireflyIsAnOutlierAndDoesNotInflateTheRobustScale) {
     }
 }
 
+// Only a pixel above its neighbours is an outlier: one far below them (a dark pixel in a bright
+// block, 0 among 0.5-2.2) is not, though it lies as far beyond their range as a firefly.
+TEST(NoiseScale, APixelBelowItsNeighboursIsNoOutlier) {
+  Image im = blocks(64, 64, 3, 0.05);
+  for (int c = 0; c < 3; ++c) {
+    im.at(20, 20, c) = 0.0f;
+    im.at(40, 9, c) = 50.0f;
+  }
+  const NoiseScales s = estimate_noise_scales(im, Roi::all(64, 64), 2);
+  EXPECT_GT(s.excess[s.at(20, 20)], kOutlierSigmas * kOutlierSigmas);
+  EXPECT_EQ(s.outlier[s.at(20, 20)], 0);
+  EXPECT_EQ(s.outlier[s.at(40, 9)], 1);
+}
+
 // A one-pixel checkerboard is all signal the image-only estimate cannot tell from noise;
 // a variance pass (as two half buffers give) tells it.
 TEST(NoiseScale, AVariancePassIsUsedWhereItIsValid) {
