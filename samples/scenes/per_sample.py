@@ -3,13 +3,15 @@ add-on's export (K one-sample sub-renders) and a reference at many samples with 
 pixel filter (every sample at the pixel centre, as in the deep file), raw Combined.
 
     blender -b --factory-startup --python-exit-code 1 --python per_sample.py -- \\
-        --scene dof|motion|dof_garden|dof_spheres --out DIR --addon-dir build/blender_addon/stage \\
+        --scene SCENE --out DIR --addon-dir build/blender_addon/stage \\
         [--spp 16] [--ref-spp 1024] [--width 128] [--height 96] [--draw N]
 
-Writes DIR/<scene>_<spp>spp_deep.exr and DIR/<scene>_ref.exr (none with --ref-spp 0), and prints
-one JSON line ("per_sample": ...) with the render times. --draw N > 0 renders another draw of the
-samples (other seeds) as DIR/<scene>_<spp>spp_draw<N>_deep.exr, to test a setting on samples
-nothing was chosen on; the reference is the same scene's."""
+SCENE: a scene module of this folder: dof, motion, dof_garden, dof_spheres are the per-sample sample
+scenes (samples/data/per_sample); any still's works too (sunlit, fence, jewel, ...: held-out
+per-sample renders, session 33). Writes DIR/<scene>_<spp>spp_deep.exr and DIR/<scene>_ref.exr (none
+with --ref-spp 0), and prints one JSON line ("per_sample": ...) with the render times. --draw N > 0
+renders another draw of the samples (other seeds) as DIR/<scene>_<spp>spp_draw<N>_deep.exr, to test
+a setting on samples nothing was chosen on; the reference is the same scene's."""
 import argparse
 import importlib
 import json
