@@ -6,6 +6,7 @@
 #include <limits>
 #include <vector>
 
+#include "metrics/metrics.h"
 #include "util/error.h"
 
 namespace mcr {
@@ -16,7 +17,6 @@ namespace {
 // share of all its samples' (in any channel): a rare path, which stratification does not make
 // less variable (.h).
 constexpr double kSpikeShare = 0.5;
-constexpr double kRelMseEps = 0.01;  // relMSE's term: (x - r)^2 / (r^2 + 0.01)
 
 // (A - B)^2 n1 n2 / n^2 for the first n1 = n / 2 of s[0, n) against the rest: in expectation the
 // variance of their mean where the two halves are independent (n >= 2).

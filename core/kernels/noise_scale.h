@@ -46,6 +46,7 @@
 #include <vector>
 
 #include "image/image.h"
+#include "metrics/metrics.h"  // kRelMseEps
 
 namespace mcr {
 
@@ -69,7 +70,6 @@ struct NoiseScales {
 };
 
 constexpr double kOutlierSigmas = 4.0;  // outlier: further than this many robust deviations
-constexpr double kRelMseEps = 0.01;     // relMSE's denominator term, (x - r)^2 / (r^2 + 0.01)
 
 // Scales for the pixels of `box` (clipped to the image); reads up to 12 pixels around it.
 // colour: RGB in its first three channels. variance: a variance pass (the variance of each

@@ -54,7 +54,7 @@ ErrorSums error_sums(const Image& ref, const Image& img, int nthreads) {
           const double ai = a[i + k], bi = b[i + k];
           const double d = bi - ai, dc = clamp01(bi) - clamp01(ai);
           s[k] += d * d;
-          r[k] += d * d / (ai * ai + 0.01);
+          r[k] += d * d / (ai * ai + kRelMseEps);
           sc[k] += dc * dc;
         }
       }
@@ -63,7 +63,7 @@ ErrorSums error_sums(const Image& ref, const Image& img, int nthreads) {
         const double ai = a[i], bi = b[i];
         const double d = bi - ai, dc = clamp01(bi) - clamp01(ai);
         s[k] += d * d;
-        r[k] += d * d / (ai * ai + 0.01);
+        r[k] += d * d / (ai * ai + kRelMseEps);
         sc[k] += dc * dc;
       }
       sq[y] = (s[0] + s[1]) + (s[2] + s[3]);

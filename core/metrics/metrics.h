@@ -15,6 +15,9 @@
 
 namespace mcr {
 
+// relMSE's denominator term, (x - r)^2 / (r^2 + 0.01): what keeps black pixels' error finite.
+constexpr double kRelMseEps = 0.01;
+
 struct ImageMetrics {
   double rmse = 0.0;    // root mean squared error
   double relmse = 0.0;  // relative MSE, (x-r)^2 / (r^2 + 0.01)
